@@ -1,0 +1,306 @@
+r"""FamilyBasis — particle families as scikit-fem elements.
+
+A family :math:`H^k` is an element whose quadrature points are its members
+``j`` and whose basis functions are its members ``i`` (formulas.md
+section 2).  With
+
+* quadrature weights (PBG, (4.25), (4.30))
+  :math:`w_{kj} = V^k V^j / V_H^k`, :math:`V_H^k = \sum_{j\in H^k} V^j`,
+* basis-function gradients :math:`G^{kji}` (MTE1/WTE1, bond and VC
+  corrections), and values :math:`\delta_{ij}` (the particle value),
+
+scikit-fem's own ``BilinearForm``/``LinearForm``/``Functional`` assemble the
+Peridynamic Bubnov–Galerkin (PBG) method:
+
+.. math::
+
+    \delta W = \sum_k \sum_{j\in H^k} w_{kj}\, P(F^{kj}) : \delta F^{kj},
+    \qquad F^{kj} = I + \sum_i u^i\otimes G^{kji}.
+
+Degrees of freedom follow scikit-fem's nodal numbering of the mesh the
+particles were collocated from (vector dof ``c`` of particle ``p`` is
+``dim * p + c``), so family bases and FE bases on the same mesh add into one
+system.  Families are padded to the largest size ``m``; padded slots have
+zero weight and zero gradient.
+"""
+import time
+
+import numpy as np
+import skfem as fem
+from skfem.assembly.basis import AbstractBasis
+from skfem.element import DiscreteField
+
+from . import families as families_mod
+from .corrections import bond_correction, vc_correction
+from .errors import FamilyError, describe_particle
+from .particles import Particles, linear_elements
+from .shape import GRADIENTS, mls1_master_values
+
+METHODS = ("PBG",)
+
+
+class FamilyBasis(AbstractBasis):
+    """A scikit-fem basis whose elements are particle families.
+
+    Parameters
+    ----------
+    particles
+        :class:`~skfem_pg.Particles`.
+    families
+        :class:`~skfem_pg.families.Families`; default: mesh connectivity
+        (``families.from_mesh``) for mesh particles, otherwise a horizon of
+        1.51 h.
+    shape
+        ``"MTE1"`` (moving Taylor expansion, formulation Unl; default) or
+        ``"WTE1"`` (static Taylor expansion = classical correspondence,
+        formulation U1).
+    bond
+        Bond correction (5.55).  Default: on for MTE1, off for WTE1.
+    vc
+        Variationally consistent correction: ``"V5"`` (default with bond
+        correction), ``"V3"`` (default for MTE1 without bond correction) or
+        ``None`` (default for WTE1: the classical, uncorrected method).
+    method
+        ``"PBG"`` (Peridynamic Bubnov–Galerkin).
+    dim
+        Number of field components: ``None`` for a scalar field (e.g.
+        Poisson), the spatial dimension for displacements.
+    weight_exponent
+        ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}` (default 1).
+    vc_solver
+        Solver of the VC constraint system: ``"auto"``, ``"direct"``,
+        ``"amg"`` or ``"lsqr"``.
+    area_vectors
+        ``(dim, np)`` surface area vectors :math:`A^i`; default: the
+        FE-consistent ones of ``particles.area_vectors()``.
+
+    Attributes
+    ----------
+    G
+        ``(nf, m, m, d)`` corrected derivatives :math:`G^{kji}`.
+    dx
+        ``(nf, m)`` weights :math:`w_{kj}`.
+    vc_report
+        :class:`~skfem_pg.corrections.VCReport` (``None`` without VC).
+    timings
+        Seconds spent on families, gradients, bond and VC correction.
+
+    """
+
+    def __init__(self, particles, families=None, shape="MTE1", bond=None,
+                 vc="auto", method="PBG", dim=None, weight_exponent=1,
+                 vc_solver="auto", area_vectors=None):
+        if not isinstance(particles, Particles):
+            raise TypeError("particles must be a skfem_pg.Particles, got {}"
+                            .format(type(particles).__name__))
+        if method not in METHODS:
+            raise NotImplementedError(
+                "method {!r} is not available; this version implements {}"
+                .format(method, ", ".join(METHODS)))
+        if shape not in GRADIENTS:
+            raise ValueError("unknown shape functions {!r}; available: {}"
+                             .format(shape, ", ".join(GRADIENTS)))
+        if bond is None:
+            bond = shape == "MTE1"
+        if vc == "auto":
+            vc = ("V5" if bond else "V3") if shape == "MTE1" else None
+        if vc == "V5" and not bond:
+            raise ValueError("vc='V5' keeps the bond mapping and needs "
+                             "bond=True; use vc='V3' without bond correction")
+        self.particles = particles
+        self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
+        self.weight_exponent = weight_exponent
+        self.timings = {}
+        x, V = particles.x, particles.volumes
+        sdim = particles.dim
+
+        t0 = time.perf_counter()
+        if families is None:
+            families = (families_mod.from_mesh(particles)
+                        if particles.mesh is not None
+                        else families_mod.horizon(particles))
+        self.families = families
+        self._check_families()
+        self.timings["families"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        G = GRADIENTS[shape](x, V, families, n=weight_exponent)
+        self.timings["gradients"] = time.perf_counter() - t0
+        if bond:
+            t0 = time.perf_counter()
+            G = bond_correction(G, x, families)
+            self.timings["bond"] = time.perf_counter() - t0
+
+        mem, mask = families.padded()
+        Vm = V[mem] * mask
+        self.dx = V[families.masters][:, None] * Vm / Vm.sum(axis=1,
+                                                              keepdims=True)
+        self.vc_report = None
+        if vc is not None:
+            t0 = time.perf_counter()
+            if area_vectors is None:
+                area_vectors = particles.area_vectors()
+            area_vectors = np.asarray(area_vectors, dtype=float)
+            if area_vectors.shape != x.shape:
+                raise ValueError("area_vectors must have shape {}, got {}"
+                                 .format(x.shape, area_vectors.shape))
+            phi = mls1_master_values(x, V, families, n=weight_exponent)
+            phi[:, 0] -= 1.0
+            G, self.vc_report = vc_correction(
+                G, self.dx, x, V, families, area_vectors, phi * mask,
+                variant=vc, solver=vc_solver)
+            self.timings["vc"] = time.perf_counter() - t0
+        self.G = G
+
+        # --- what scikit-fem's assembly reads ---------------------------
+        self.ncomp = dim
+        nc = 1 if dim is None else int(dim)
+        self.mesh = particles.mesh if particles.kind == "vertices" else None
+        if self.mesh is not None:
+            e1, _ = linear_elements(self.mesh)
+            self.elem = e1 if dim is None else fem.ElementVector(e1, dim=nc)
+            self.dofs = fem.assembly.Dofs(self.mesh, self.elem)
+        else:
+            self.elem = None
+            self.dofs = None
+        self._N = nc * particles.n
+        self.doflocs = np.repeat(x, nc, axis=1)
+        nf, m = mem.shape
+        self.nelems = nf
+        self.Nbfun = nc * m
+        self.tind = None
+        self._element_dofs = (nc * mem[:, :, None] + np.arange(nc)) \
+            .reshape(nf, nc * m).T.astype(np.int64)
+        self.X = np.zeros((sdim, m))  # members play the quadrature points
+        self.W = np.ones(m)
+        self._basis = None
+        self._pattern = None
+
+    # ------------------------------------------------------------------
+    def _check_families(self):
+        p, fam = self.particles, self.families
+        if fam.n_particles != p.n:
+            raise FamilyError("families refer to {} particles, the particle "
+                              "set has {}".format(fam.n_particles, p.n))
+        inactive = ~p.active[fam.members]
+        if np.any(inactive):
+            q = fam.members[np.nonzero(inactive)[0][0]]
+            raise FamilyError("{} has zero volume but is a family member"
+                              .format(describe_particle(q, p.x[:, q])))
+        need = p.dim + 1 if self.shape in ("MTE1", "WTE1") else p.dim + 2
+        if self.vc is not None:
+            need = p.dim + 2  # MLS1 at the master without the master
+        families_mod.check_supports(p, fam, need, "{}{}".format(
+            self.shape, " with VC correction" if self.vc else ""))
+
+    @property
+    def N(self):
+        return self._N
+
+    @property
+    def element_dofs(self):
+        return self._element_dofs
+
+    @property
+    def basis(self):
+        """Basis functions at the members, built on first use (only the
+        generic scikit-fem assembly path needs them)."""
+        if self._basis is None:
+            self._basis = [self._basis_function(ix)
+                           for ix in range(self.Nbfun)]
+        return self._basis
+
+    def _basis_function(self, ix):
+        nc = 1 if self.ncomp is None else self.ncomp
+        a, c = divmod(ix, nc)
+        mem, mask = self.families.padded()
+        nf, m = mem.shape
+        value = np.zeros((nf, m))
+        value[:, a] = mask[:, a]
+        grad = np.moveaxis(self.G[:, :, a, :], -1, 0)
+        if self.ncomp is None:
+            return (DiscreteField(value, grad),)
+        V = np.zeros((nc, nf, m))
+        V[c] = value
+        Gr = np.zeros((nc,) + grad.shape)
+        Gr[c] = grad
+        return (DiscreteField(V, Gr),)
+
+    def interpolate(self, w):
+        r"""Values and gradients of the nodal field ``w`` at the members:
+        value :math:`u^j`, gradient :math:`\sum_i u^i\otimes G^{kji}`
+        (so :math:`F = I + \text{grad}` for displacements)."""
+        w = np.asarray(w)
+        if w.shape[0] != self.N:
+            raise ValueError("Input array has wrong size: {} != N = {}"
+                             .format(w.shape[0], self.N))
+        mem, mask = self.families.padded()
+        if self.ncomp is None:
+            U = w[mem]
+            value = U * mask
+            grad = np.einsum("ki,kjid->dkj", U, self.G)
+            return DiscreteField(value, grad)
+        nc = self.ncomp
+        U = w.reshape(-1, nc)[mem]  # (nf, m, nc)
+        value = np.moveaxis(U * mask[..., None], -1, 0)
+        grad = np.einsum("kic,kjid->cdkj", U, self.G)
+        return DiscreteField(value, grad)
+
+    def global_coordinates(self):
+        mem, _ = self.families.padded()
+        return DiscreteField(np.moveaxis(self.particles.x.T[mem], -1, 0))
+
+    def mesh_parameters(self):
+        """Family radius :math:`h_k` at every member."""
+        mem, mask = self.families.padded()
+        P = self.particles.x.T[mem]
+        h = np.sqrt(((P - P[:, :1]) ** 2).sum(-1).max(axis=1))
+        return DiscreteField(np.broadcast_to(h[:, None], mem.shape).copy())
+
+    def default_parameters(self):
+        """``w.x`` (member positions) and ``w.h`` (family radius)."""
+        return {"x": self.global_coordinates(),
+                "h": self.mesh_parameters()}
+
+    def get_dofs(self, facets=None, elements=None, nodes=None, skip=None):
+        """Global dofs, as scikit-fem's ``Basis.get_dofs``.
+
+        With vertex particles, ``facets`` (indices, callable, boundary name),
+        ``elements`` and ``nodes`` refer to the mesh and the result is a
+        scikit-fem ``DofsView``.  Other particle sets accept ``nodes`` only
+        (particle indices or a callable on positions ``x`` of shape
+        ``(dim, n)``) and return an index array.
+        """
+        if self.dofs is not None:
+            return super().get_dofs(facets=facets, elements=elements,
+                                    nodes=nodes, skip=skip)
+        if nodes is None:
+            raise ValueError("{} particles have no mesh facets: select dofs "
+                             "with nodes=<indices or callable>".format(
+                                 self.particles.kind))
+        if callable(nodes):
+            nodes = np.nonzero(nodes(self.particles.x))[0]
+        nc = 1 if self.ncomp is None else self.ncomp
+        nodes = np.asarray(nodes, dtype=np.int64)
+        return (nc * nodes[:, None] + np.arange(nc)).ravel()
+
+    def complement_dofs(self, *D):
+        if self.dofs is not None:
+            return super().complement_dofs(*D)
+        return np.setdiff1d(np.arange(self.N), np.concatenate(
+            [np.asarray(d).ravel() for d in D]))
+
+    def split(self, x):
+        if self.ncomp is None:
+            return [(x, self)]
+        return [(x[c::self.ncomp], None) for c in range(self.ncomp)]
+
+    def __repr__(self):
+        s = self.families.sizes
+        return ("<skfem_pg FamilyBasis {} {}{}{}: {} families (size {}..{}),"
+                " {} dofs>".format(
+                    self.method, self.shape, "+BC" if self.bond else "",
+                    "+" + self.vc if self.vc else "", self.nelems, s.min(),
+                    s.max(), self.N))
+
+    __str__ = __repr__

@@ -1,0 +1,24 @@
+"""Exceptions raised on bad input.
+
+Every message names the culprit (particle index, position, family size) so a
+user can find it in ParaView or in the mesh file.
+"""
+
+
+class ParticleError(ValueError):
+    """Invalid particle set: non-positive volume, duplicate positions, ..."""
+
+
+class FamilyError(ValueError):
+    """A family cannot support the requested basis (too few or collinear /
+    coplanar members; singular moment matrix)."""
+
+
+class UnsupportedMeshError(TypeError):
+    """The mesh type is not a linear scikit-fem mesh (tri, quad, tet, hex)."""
+
+
+def describe_particle(index, x):
+    """``'particle 12 at (0.5, 1.25)'`` — used in error messages."""
+    pos = ", ".join("{:.6g}".format(c) for c in x)
+    return "particle {} at ({})".format(int(index), pos)

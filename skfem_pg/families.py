@@ -1,0 +1,273 @@
+r"""Particle families :math:`H^k` — the "elements" of a PG method.
+
+A family is an ordered list of particle indices, **master first**
+(formulas.md section 1).  :class:`Families` stores them ragged (CSR-like
+``offsets``/``members``) and hands out a padded ``(nf, m)`` view with a mask
+for the batched shape-function kernels.
+
+Builders
+--------
+:func:`from_mesh`
+    FE connectivity: all vertices of the elements adjacent to the master
+    (for centroid particles: all elements sharing a vertex).
+:func:`horizon`
+    All particles with :math:`|X^i - X^k| \le \delta`, ``delta`` a multiple
+    of the mean spacing (KD-tree).
+:func:`nearest`
+    The ``n`` nearest particles, with pairwise completion (``j`` joins
+    :math:`H^k` whenever ``k`` is in :math:`H^j`).
+
+Every builder enlarges families that are too small, or whose non-master
+members do not span the space (collinear in 2-D, coplanar in 3-D), by the
+next ring of neighbours: MLS1 at the master, needed by the VC correction,
+requires ``dim + 1`` non-master members in general position.
+"""
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+from .errors import FamilyError, describe_particle
+
+
+class Families:
+    """Ragged family storage.
+
+    Parameters
+    ----------
+    offsets
+        ``(nf + 1,)`` start of each family in ``members``.
+    members
+        Concatenated member indices; the first member of each family is its
+        master.
+    n_particles
+        Size of the particle set the indices refer to.
+
+    """
+
+    def __init__(self, offsets, members, n_particles):
+        self.offsets = np.asarray(offsets, dtype=np.int64)
+        self.members = np.asarray(members, dtype=np.int64)
+        self.n_particles = int(n_particles)
+        if self.offsets[0] != 0 or self.offsets[-1] != len(self.members) \
+                or np.any(np.diff(self.offsets) < 1):
+            raise FamilyError("inconsistent family offsets")
+        if len(self.members) and (self.members.min() < 0 or
+                                  self.members.max() >= self.n_particles):
+            raise FamilyError("family members refer to particles outside "
+                              "0..{}".format(self.n_particles - 1))
+        if len(np.unique(self.masters)) != len(self):
+            raise FamilyError("two families have the same master")
+        self._padded = None
+
+    def __len__(self):
+        return len(self.offsets) - 1
+
+    @property
+    def masters(self):
+        """Master particle of each family."""
+        return self.members[self.offsets[:-1]]
+
+    @property
+    def sizes(self):
+        """Number of members ``n_k`` (master included)."""
+        return np.diff(self.offsets)
+
+    def padded(self):
+        """``(members, mask)`` as ``(nf, m)`` arrays, ``m = max n_k``.
+
+        Padding slots repeat the master index and have ``mask == False``.
+        """
+        if self._padded is None:
+            sizes = self.sizes
+            m = int(sizes.max())
+            local = np.arange(m)
+            mask = local[None, :] < sizes[:, None]
+            mem = np.repeat(self.masters[:, None], m, axis=1)
+            mem[mask] = self.members
+            self._padded = (mem, mask)
+        return self._padded
+
+    def __repr__(self):
+        s = self.sizes
+        return ("<skfem_pg Families: {} families, size min/mean/max "
+                "{}/{:.1f}/{}>".format(len(self), s.min(), s.mean(), s.max()))
+
+    @classmethod
+    def from_adjacency(cls, adjacency, masters):
+        """Families from a sparse particle adjacency.
+
+        Row ``k`` of ``adjacency`` (``n_particles`` square) lists the members
+        of the family of master ``k``; only the rows in ``masters`` are used.
+        The master is put first, the others keep ascending order.
+        """
+        A = sp.csr_matrix(adjacency)
+        A = (A[masters] + sp.csr_matrix(
+            (np.ones(len(masters)), (np.arange(len(masters)), masters)),
+            shape=(len(masters), A.shape[1]))).tocsr()
+        A.sum_duplicates()
+        A.sort_indices()
+        rows = np.repeat(np.arange(len(masters)), np.diff(A.indptr))
+        cols = A.indices.astype(np.int64)
+        order = np.lexsort((cols, cols != masters[rows], rows))
+        return cls(A.indptr, cols[order], A.shape[1])
+
+    def adjacency(self):
+        """Sparse ``(n_particles, n_particles)`` boolean adjacency (rows =
+        masters)."""
+        rows = np.repeat(self.masters, self.sizes)
+        return sp.csr_matrix((np.ones(len(self.members), dtype=bool),
+                              (rows, self.members)),
+                             shape=(self.n_particles, self.n_particles))
+
+
+def _needs_enlargement(x, fam, min_size):
+    """Families with too few members or with non-master members that do not
+    span the space affinely."""
+    mem, mask = fam.padded()
+    d = x.shape[0]
+    small = fam.sizes < min_size
+    # centred non-master member positions, scaled per family
+    others = mask.copy()
+    others[:, 0] = False
+    P = x.T[mem]  # (nf, m, d)
+    cnt = np.maximum(others.sum(axis=1), 1)
+    c = (P * others[..., None]).sum(axis=1) / cnt[:, None]
+    D = (P - c[:, None, :]) * others[..., None]
+    h = np.maximum(np.abs(D).max(axis=(1, 2)), 1e-300)
+    D = D / h[:, None, None]
+    S = np.einsum("kia,kib->kab", D, D)
+    ev = np.linalg.eigvalsh(S)
+    flat = ev[:, 0] <= 1e-8 * np.maximum(ev[:, -1], 1e-300)
+    return small | flat
+
+
+def _complete(x, A, masters, min_size, max_rings=3):
+    """Build families from ``A`` and enlarge the deficient ones ring by
+    ring."""
+    fam = Families.from_adjacency(A, masters)
+    A = A.tocsr().astype(bool)
+    for _ in range(max_rings):
+        need = _needs_enlargement(x, fam, min_size)
+        if not np.any(need):
+            break
+        rows = masters[need]
+        R = sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, rows)),
+                          shape=A.shape)
+        A = (A + R @ A @ A).astype(bool)
+        fam = Families.from_adjacency(A, masters)
+    return fam
+
+
+def _mesh_of(obj):
+    from .particles import Particles
+    if isinstance(obj, Particles):
+        return obj.mesh, obj.kind, obj.elements, obj.x
+    return obj, "vertices", None, obj.p
+
+
+def from_mesh(mesh_or_particles, elements=None, min_size=None):
+    """Families from mesh connectivity (the default builder).
+
+    Parameters
+    ----------
+    mesh_or_particles
+        A scikit-fem mesh (vertex particles) or a :class:`Particles` built by
+        ``Particles.from_mesh`` (its kind and element subset are used).
+    elements
+        Optional element subset (vertex particles only); families are built
+        for the vertices of these elements from these elements alone.
+    min_size
+        Minimum family size, master included (default ``dim + 2``).
+        Smaller families, and families whose non-master members are
+        collinear/coplanar, get the next ring of neighbours.
+
+    """
+    mesh, kind, pel, x = _mesh_of(mesh_or_particles)
+    if mesh is None:
+        raise FamilyError("these particles have no mesh; use "
+                          "families.horizon or families.nearest")
+    if elements is None:
+        elements = pel
+    d = mesh.dim()
+    min_size = d + 2 if min_size is None else int(min_size)
+    if kind == "centroids":
+        tind = pel  # particle p is element tind[p]
+        nv, ne = mesh.nvertices, len(tind)
+        E = sp.csr_matrix((np.ones(mesh.t.shape[0] * ne, dtype=bool),
+                           (mesh.t[:, tind].ravel(),
+                            np.tile(np.arange(ne), mesh.t.shape[0]))),
+                          shape=(nv, ne))
+        A = (E.T @ E).astype(bool)
+        return _complete(x, A, np.arange(ne), min_size)
+    tind = (np.arange(mesh.nelements) if elements is None
+            else np.asarray(mesh.normalize_elements(elements)))
+    t = mesh.t[:, tind]
+    nv = mesh.nvertices
+    E = sp.csr_matrix((np.ones(t.size, dtype=bool),
+                       (t.ravel(), np.tile(np.arange(len(tind)), t.shape[0]))),
+                      shape=(nv, len(tind)))
+    A = (E @ E.T).astype(bool)
+    masters = np.unique(t)
+    return _complete(x, A, masters, min_size)
+
+
+def _active_tree(particles):
+    act = np.nonzero(particles.active)[0]
+    return act, cKDTree(particles.x[:, act].T)
+
+
+def horizon(particles, delta=None, factor=1.51, min_size=None):
+    r"""Families of all particles within the horizon ``delta``.
+
+    ``delta`` defaults to ``factor`` times the mean spacing
+    :math:`h = \overline{V}^{1/d}` (thesis: 1.51 h ... 3.01 h).
+    """
+    act, tree = _active_tree(particles)
+    if delta is None:
+        delta = factor * particles.spacing
+    if delta <= 0:
+        raise FamilyError("the horizon must be positive, got {}".format(delta))
+    pairs = tree.query_pairs(r=delta, output_type="ndarray")
+    i, j = act[pairs[:, 0]], act[pairs[:, 1]]
+    n = particles.n
+    A = sp.csr_matrix((np.ones(2 * len(i), dtype=bool),
+                       (np.r_[i, j], np.r_[j, i])), shape=(n, n))
+    d = particles.dim
+    return _complete(particles.x, A, act,
+                     d + 2 if min_size is None else min_size)
+
+
+def nearest(particles, n, pairwise=True, min_size=None):
+    """Families of the ``n`` nearest neighbours of each particle, made
+    pairwise (``j`` in ``H^k`` whenever ``k`` in ``H^j``) by default."""
+    act, tree = _active_tree(particles)
+    if n < 1 or n >= len(act):
+        raise FamilyError("need 1 <= n < {} (active particles), got {}"
+                          .format(len(act), n))
+    _, idx = tree.query(particles.x[:, act].T, k=n + 1)
+    rows = np.repeat(act, n + 1)
+    cols = act[idx.ravel()]
+    N = particles.n
+    A = sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, cols)),
+                      shape=(N, N))
+    if pairwise:
+        A = (A + A.T).tocsr()
+    d = particles.dim
+    return _complete(particles.x, A, act,
+                     d + 2 if min_size is None else min_size)
+
+
+def check_supports(particles, families, n_required, what):
+    """Raise :class:`FamilyError` naming the first family with fewer than
+    ``n_required`` members."""
+    small = np.nonzero(families.sizes < n_required)[0]
+    if len(small):
+        k = small[0]
+        p = families.masters[k]
+        raise FamilyError(
+            "family of {} has {} members; {} needs at least {} ({} families "
+            "are too small). Use a larger horizon or more neighbours."
+            .format(describe_particle(p, particles.x[:, p]),
+                    families.sizes[k], what, n_required, len(small)))
+
+
+__all__ = ["Families", "from_mesh", "horizon", "nearest", "check_supports"]

@@ -1,0 +1,94 @@
+"""Node sets for tests and benchmarks: distorted meshes, Cook's membrane,
+gmsh geometries.
+
+gmsh is used through its Python API; ``.geo`` sources live in ``meshes/``.
+"""
+import os
+import tempfile
+
+import numpy as np
+import skfem as fem
+
+#: Cook's membrane corners (thesis 7.1)
+COOK_CORNERS = np.array([[0.0, 0.0], [48.0, 44.0], [48.0, 60.0], [0.0, 44.0]])
+
+
+def distort(mesh, amount=0.3, seed=0):
+    """Perturb the interior vertices by up to ``amount·h`` in each
+    coordinate (uniform random), ``h`` the shortest edge at the vertex.
+
+    Boundary vertices stay put, so the domain is unchanged (the ±0.3 h
+    irregular node sets of the thesis).
+    """
+    rng = np.random.default_rng(seed)
+    p = mesh.p.copy()
+    e = mesh.edges if mesh.dim() == 3 else mesh.facets
+    L = np.linalg.norm(p[:, e[0]] - p[:, e[1]], axis=0)
+    h = np.full(mesh.nvertices, np.inf)
+    np.minimum.at(h, e[0], L)
+    np.minimum.at(h, e[1], L)
+    interior = np.setdiff1d(np.arange(mesh.nvertices), mesh.boundary_nodes())
+    p[:, interior] += (rng.uniform(-amount, amount, (mesh.dim(), len(interior)))
+                       * h[interior])
+    return type(mesh)(p, mesh.t)
+
+
+def _bilinear_map(xi, eta, corners):
+    c = corners
+    return ((1 - xi) * (1 - eta) * c[0][:, None] + xi * (1 - eta) * c[1][:, None]
+            + xi * eta * c[2][:, None] + (1 - xi) * eta * c[3][:, None])
+
+
+def cook_membrane(n, kind="quad"):
+    """Cook's membrane with ``n`` elements per side.
+
+    ``kind``: ``"quad"`` (MeshQuad), ``"tri"`` (the same nodes, each quad
+    split in two triangles).  Boundaries ``left`` (clamped in the benchmark)
+    and ``right`` (loaded) are named.
+    """
+    m = fem.MeshQuad.init_tensor(np.linspace(0, 1, n + 1),
+                                 np.linspace(0, 1, n + 1))
+    p = _bilinear_map(m.p[0], m.p[1], COOK_CORNERS)
+    mesh = fem.MeshQuad(p, m.t)
+    if kind == "tri":
+        mesh = mesh.to_meshtri()
+    elif kind != "quad":
+        raise ValueError("kind must be 'quad' or 'tri'")
+    return mesh.with_boundaries({
+        "left": lambda x: np.isclose(x[0], 0.0),
+        "right": lambda x: np.isclose(x[0], 48.0),
+    })
+
+
+def from_geo(path, size=None, order=1, algorithm=None):
+    """Mesh a gmsh ``.geo`` file and load it as a scikit-fem mesh.
+
+    ``size`` sets ``Mesh.MeshSizeMax`` (and scales ``MeshSizeMin``).
+    Physical groups become ``mesh.boundaries``/``mesh.subdomains``.
+    """
+    import gmsh
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(str(path))
+        if size is not None:
+            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * size)
+        if algorithm is not None:
+            gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+        dim = gmsh.model.getDimension()
+        gmsh.model.mesh.generate(dim)
+        gmsh.model.mesh.setOrder(order)
+        with tempfile.TemporaryDirectory() as tmp:
+            fn = os.path.join(tmp, "mesh.msh")
+            gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+            gmsh.write(fn)
+            return fem.Mesh.load(fn)
+    finally:
+        gmsh.finalize()
+
+
+def geo_path(name):
+    """Path of a ``.geo`` file shipped in ``meshes/``."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    return os.path.join(os.path.dirname(here), "meshes", name)

@@ -1,0 +1,271 @@
+r"""Particles collocated from scikit-fem meshes.
+
+A particle ``p`` carries a reference position :math:`X^p` and a volume
+:math:`V^p > 0` (formulas.md section 1).  Two collocations are offered:
+
+* ``kind="vertices"`` (default): positions are the mesh vertices and the
+  volumes are lumped, :math:`V^p = \int_\Omega N_p \,d\Omega` (row sum of the
+  consistent P1/Q1 mass matrix).  Particle ``p`` is mesh vertex ``p``, so the
+  degrees of freedom coincide with scikit-fem's nodal numbering and FE and PG
+  matrices can be added.
+* ``kind="centroids"``: positions are element barycentres and volumes are the
+  element volumes; no particle lies on the surface.
+
+Surface area vectors :math:`A^i = \int_{\partial\Omega} N_i \, n \,d\Gamma`
+(thesis (5.18); FE consistent with the linear boundary facets) are what the
+variationally consistent (VC) correction needs on the surface.
+"""
+from typing import Optional
+
+import numpy as np
+from scipy.spatial import cKDTree
+import skfem as fem
+
+from .errors import ParticleError, UnsupportedMeshError, describe_particle
+
+# nodal (P1/Q1) and constant (P0) element of each supported linear mesh
+_LINEAR_ELEMENTS = {
+    fem.ElementTriP1: (fem.ElementTriP1, fem.ElementTriP0),
+    fem.ElementQuad1: (fem.ElementQuad1, fem.ElementQuad0),
+    fem.ElementTetP1: (fem.ElementTetP1, fem.ElementTetP0),
+    fem.ElementHex1: (fem.ElementHex1, fem.ElementHex0),
+}
+
+
+def linear_elements(mesh):
+    """Return ``(nodal_element, constant_element)`` instances for ``mesh``.
+
+    Raises :class:`UnsupportedMeshError` for anything but MeshTri1, MeshQuad1,
+    MeshTet1 and MeshHex1.
+    """
+    if not isinstance(mesh, fem.Mesh):
+        raise UnsupportedMeshError(
+            "expected a scikit-fem Mesh, got {}".format(type(mesh).__name__))
+    pair = _LINEAR_ELEMENTS.get(mesh.elem)
+    if pair is None:
+        raise UnsupportedMeshError(
+            "{} is not supported: particles are collocated from linear "
+            "triangle, quadrilateral, tetrahedron or hexahedron meshes "
+            "(MeshTri1, MeshQuad1, MeshTet1, MeshHex1)"
+            .format(type(mesh).__name__))
+    return pair[0](), pair[1]()
+
+
+def _check_elements(mesh, elements):
+    """Reject degenerate and inverted (self-overlapping) elements."""
+    e1, _ = linear_elements(mesh)
+    X, _ = fem.quadrature.get_quadrature(mesh.refdom, 2)
+    det = mesh._mapping().detDF(X, tind=elements)
+    scale = np.median(np.abs(det))
+    bad = np.min(np.abs(det), axis=1) <= 1e-12 * scale
+    if not isinstance(e1, (fem.ElementTriP1, fem.ElementTetP1)):
+        # multilinear elements: the Jacobian must not change sign inside
+        bad |= (np.min(det, axis=1) * np.max(det, axis=1)) <= 0
+    if np.any(bad):
+        e = elements[np.nonzero(bad)[0][0]]
+        c = mesh.p[:, mesh.t[:, e]].mean(axis=1)
+        raise ParticleError(
+            "mesh element {} (centre {}) is degenerate or inverted "
+            "(det J = {:.3g} .. {:.3g}); its particles would get a "
+            "non-positive volume".format(
+                e, tuple(np.round(c, 6)), det[bad][0].min(), det[bad][0].max()))
+
+
+class Particles:
+    r"""Reference positions and volumes of a particle set.
+
+    Parameters
+    ----------
+    x
+        Positions, shape ``(dim, n)`` (scikit-fem's layout, like ``mesh.p``).
+    volumes
+        Volumes :math:`V^p`, shape ``(n,)``.  Particles with zero volume are
+        *inactive*: they keep their index (and degrees of freedom) but belong
+        to no family; this is how a PG subdomain keeps the global numbering
+        of the whole mesh.  Negative volumes are an error.
+    mesh, kind, elements
+        Provenance, set by :meth:`from_mesh`.  ``mesh`` is needed for surface
+        area vectors, boundary loads and ``get_dofs`` by facets.
+
+    """
+
+    def __init__(self, x, volumes, mesh=None, kind="points", elements=None):
+        x = np.atleast_2d(np.asarray(x, dtype=float))
+        volumes = np.asarray(volumes, dtype=float).ravel()
+        if x.shape[0] not in (1, 2, 3):
+            raise ParticleError(
+                "positions must have shape (dim, n) with dim 1, 2 or 3; "
+                "got {}".format(x.shape))
+        if volumes.shape[0] != x.shape[1]:
+            raise ParticleError(
+                "{} volumes given for {} particles".format(volumes.shape[0],
+                                                           x.shape[1]))
+        self.x = x
+        self.volumes = volumes
+        self.mesh = mesh
+        self.kind = kind
+        self.elements = elements
+        self._area_vectors = None
+        self._validate(allow_inactive=elements is not None)
+
+    # -- construction ------------------------------------------------------
+    @classmethod
+    def from_mesh(cls, mesh, kind="vertices", elements=None):
+        """Collocate particles from a linear scikit-fem mesh.
+
+        Parameters
+        ----------
+        mesh
+            MeshTri1, MeshQuad1, MeshTet1 or MeshHex1.
+        kind
+            ``"vertices"``: vertices with lumped volumes :math:`\\int N_p`;
+            ``"centroids"``: element barycentres with element volumes.
+        elements
+            Optional subset of elements (anything ``mesh.normalize_elements``
+            accepts, e.g. a callable or a subdomain name).  With vertex
+            particles the volumes are lumped over this subset only and
+            vertices outside it are inactive (zero volume): use this for the
+            PG part of an FE–PG coupled model.
+
+        """
+        e1, e0 = linear_elements(mesh)
+        subset = None if elements is None else \
+            np.asarray(mesh.normalize_elements(elements), dtype=np.int64)
+        tind = np.arange(mesh.nelements) if subset is None else subset
+        if len(tind) == 0:
+            raise ParticleError("the element subset is empty")
+        _check_elements(mesh, tind)
+        if kind == "vertices":
+            basis = fem.Basis(mesh, e1, elements=subset)
+            volumes = fem.LinearForm(lambda v, w: v).assemble(basis)
+            if subset is not None:
+                untouched = np.setdiff1d(np.arange(mesh.nvertices),
+                                         np.unique(mesh.t[:, subset]))
+                volumes[untouched] = 0.0
+            return cls(mesh.p.copy(), volumes, mesh=mesh, kind="vertices",
+                       elements=subset)
+        if kind == "centroids":
+            basis = fem.Basis(mesh, e0, elements=subset)
+            dx = basis.dx
+            xq = basis.global_coordinates()
+            vol = dx.sum(axis=1)
+            x = np.einsum("dkq,kq->dk", np.asarray(xq), dx) / vol
+            # elements keeps the map particle -> element
+            obj = cls(x, vol, mesh=mesh, kind="centroids", elements=None)
+            obj.elements = tind
+            return obj
+        raise ValueError("kind must be 'vertices' or 'centroids', "
+                         "got {!r}".format(kind))
+
+    @classmethod
+    def from_file(cls, filename, kind="vertices", **kwargs):
+        """Read a mesh (e.g. a gmsh ``.msh`` file) with ``skfem.Mesh.load``
+        and collocate particles from it.  Physical groups become
+        ``mesh.boundaries`` / ``mesh.subdomains``."""
+        mesh = fem.Mesh.load(filename, **kwargs)
+        return cls.from_mesh(mesh, kind=kind)
+
+    # -- properties --------------------------------------------------------
+    @property
+    def dim(self):
+        """Spatial dimension."""
+        return self.x.shape[0]
+
+    @property
+    def n(self):
+        """Number of particles (active and inactive)."""
+        return self.x.shape[1]
+
+    def __len__(self):
+        return self.n
+
+    @property
+    def active(self):
+        """Boolean mask of particles with positive volume."""
+        return self.volumes > 0
+
+    @property
+    def spacing(self):
+        r"""Mean particle spacing :math:`h = \overline{V}^{1/d}`."""
+        return float(np.mean(self.volumes[self.active]) ** (1.0 / self.dim))
+
+    def __repr__(self):
+        return "<skfem_pg Particles: {} {} in {}-D, {} active, h={:.4g}>".format(
+            self.n, self.kind, self.dim, int(self.active.sum()), self.spacing)
+
+    # -- validation --------------------------------------------------------
+    def _validate(self, allow_inactive):
+        x, v = self.x, self.volumes
+        if not np.all(np.isfinite(x)):
+            p = np.nonzero(~np.all(np.isfinite(x), axis=0))[0][0]
+            raise ParticleError("{} has a non-finite position".format(
+                describe_particle(p, x[:, p])))
+        bad = ~np.isfinite(v) | (v < 0) | ((v == 0) & (not allow_inactive))
+        if np.any(bad):
+            p = np.nonzero(bad)[0][0]
+            raise ParticleError(
+                "{} has volume {:.6g}; volumes must be positive ({} of {} "
+                "particles are affected)".format(
+                    describe_particle(p, x[:, p]), v[p], int(bad.sum()),
+                    len(v)))
+        act = np.nonzero(self.active)[0]
+        if len(act) == 0:
+            raise ParticleError("no particle has a positive volume")
+        tree = cKDTree(x[:, act].T)
+        h = np.mean(v[act]) ** (1.0 / self.dim)
+        pairs = tree.query_pairs(r=1e-9 * h, output_type="ndarray")
+        if len(pairs):
+            a, b = act[pairs[0]]
+            raise ParticleError(
+                "{} and particle {} are duplicates (distance {:.3g}, mean "
+                "spacing {:.3g}); {} duplicate pair(s) in total".format(
+                    describe_particle(a, x[:, a]), b,
+                    np.linalg.norm(x[:, a] - x[:, b]), h, len(pairs)))
+
+    # -- surface -----------------------------------------------------------
+    def boundary_facets(self):
+        """Oriented boundary facets of the particles' mesh region."""
+        self._need_mesh("boundary facets")
+        elements = (np.arange(self.mesh.nelements) if self.elements is None
+                    else self.elements)
+        return self.mesh.facets_around(elements)
+
+    def area_vectors(self, facets=None):
+        r"""FE-consistent nodal area vectors, shape ``(dim, n)``.
+
+        .. math::  A^i = \int_{\Gamma} N_i \, n \, d\Gamma
+
+        over the boundary of the particles' region (default; for a subdomain
+        this includes the interface with the rest of the mesh, with normals
+        pointing out of the subdomain) or over the given ``facets``.  For
+        centroid particles :math:`N_i` is the element indicator.  Interior
+        particles get :math:`A^i = 0`.  Used as the right-hand side of the
+        integration constraint (5.18) and for Neumann loads.
+        """
+        if facets is None and self._area_vectors is not None:
+            return self._area_vectors
+        self._need_mesh("area vectors")
+        fb = self._facet_basis(facets)
+        out = np.zeros((self.dim, fb.N))
+        for c in range(self.dim):
+            out[c] = fem.LinearForm(lambda v, w: v * w.n[c]).assemble(fb)
+        if self.kind == "centroids":
+            out = out[:, self.elements]
+        if facets is None:
+            self._area_vectors = out
+        return out
+
+    def _facet_basis(self, facets=None, vector=False):
+        e1, e0 = linear_elements(self.mesh)
+        elem = e1 if self.kind == "vertices" else e0
+        if vector:
+            elem = fem.ElementVector(elem)
+        facets = (self.boundary_facets() if facets is None
+                  else self.mesh.normalize_facets(facets))
+        return fem.FacetBasis(self.mesh, elem, facets=facets, intorder=3)
+
+    def _need_mesh(self, what):
+        if self.mesh is None:
+            raise ParticleError(
+                "{} need the mesh the particles were collocated from; "
+                "build the particles with Particles.from_mesh".format(what))

@@ -1,0 +1,13 @@
+"""Batched shape-function derivatives over all families (no per-family
+Python loop).  One module per construction."""
+from .taylor import wte1_gradients, mte1_gradients
+from .least_squares import mls1_master_values
+
+#: shape-function derivative builders by name (thesis Table 5.1)
+GRADIENTS = {
+    "WTE1": wte1_gradients,
+    "MTE1": mte1_gradients,
+}
+
+__all__ = ["wte1_gradients", "mte1_gradients", "mls1_master_values",
+           "GRADIENTS"]

@@ -1,0 +1,131 @@
+r"""Shared pieces of the batched shape-function kernels.
+
+All kernels work on the padded family view ``(nf, m)`` of
+:meth:`Families.padded` and process families in chunks, so memory stays
+bounded and there is no Python loop per family.  Geometry is normalised per
+family (offsets by the family radius :math:`h_k`, volumes by their family
+mean); the derivatives are scaled back by :math:`1/h_k`.  This keeps the
+moment matrices well conditioned and the singularity test scale invariant.
+"""
+import numpy as np
+
+from ..errors import FamilyError, describe_particle
+
+#: a normalised moment matrix with determinant below this is singular
+SINGULAR_TOL = 1e-10
+
+
+class FamilyGeometry:
+    """Normalised member positions and volumes of a chunk of families.
+
+    Attributes
+    ----------
+    mem, mask
+        ``(nf, m)`` member indices and validity.
+    D0
+        ``(nf, m, d)`` offsets :math:`(X^i - X^k)/h_k` from the master.
+    V
+        ``(nf, m)`` member volumes divided by the family mean (0 if padded).
+    h
+        ``(nf,)`` family radius :math:`h_k = \max_i |X^i - X^k|`.
+
+    """
+
+    def __init__(self, x, volumes, mem, mask):
+        self.mem, self.mask = mem, mask
+        P = x.T[mem]
+        D0 = (P - P[:, :1, :]) * mask[..., None]
+        h = np.sqrt((D0 ** 2).sum(axis=-1).max(axis=1))
+        self.h = np.where(h > 0, h, 1.0)
+        self.D0 = D0 / self.h[:, None, None]
+        V = volumes[mem] * mask
+        self.V = V / (V.sum(axis=1, keepdims=True) / mask.sum(axis=1,
+                                                              keepdims=True))
+
+
+def chunks(nf, m, budget=2 ** 22):
+    """Slices over families such that ``chunk * m * m`` stays near
+    ``budget``."""
+    step = max(1, budget // max(1, m * m))
+    return [slice(a, min(a + step, nf)) for a in range(0, nf, step)]
+
+
+def weights(r2, n):
+    r"""Weights :math:`\omega = 1/|\Delta X|^{2n}` from squared distances
+    (5.41); zero where ``r2 == 0``."""
+    safe = np.where(r2 > 0, r2, 1.0)
+    return np.where(r2 > 0, safe ** (-float(n)), 0.0)
+
+
+def _det(M):
+    q = M.shape[-1]
+    if q == 1:
+        return M[..., 0, 0]
+    if q == 2:
+        return M[..., 0, 0] * M[..., 1, 1] - M[..., 0, 1] * M[..., 1, 0]
+    if q == 3:
+        return (M[..., 0, 0] * (M[..., 1, 1] * M[..., 2, 2]
+                                - M[..., 1, 2] * M[..., 2, 1])
+                - M[..., 0, 1] * (M[..., 1, 0] * M[..., 2, 2]
+                                  - M[..., 1, 2] * M[..., 2, 0])
+                + M[..., 0, 2] * (M[..., 1, 0] * M[..., 2, 1]
+                                  - M[..., 1, 1] * M[..., 2, 0]))
+    return np.linalg.det(M)
+
+
+def _inv_closed(M, det):
+    q = M.shape[-1]
+    out = np.empty_like(M)
+    if q == 1:
+        out[..., 0, 0] = 1.0
+    elif q == 2:
+        out[..., 0, 0] = M[..., 1, 1]
+        out[..., 1, 1] = M[..., 0, 0]
+        out[..., 0, 1] = -M[..., 0, 1]
+        out[..., 1, 0] = -M[..., 1, 0]
+    else:  # q == 3, adjugate
+        for a in range(3):
+            for b in range(3):
+                r = [i for i in range(3) if i != b]
+                c = [i for i in range(3) if i != a]
+                minor = (M[..., r[0], c[0]] * M[..., r[1], c[1]]
+                         - M[..., r[0], c[1]] * M[..., r[1], c[0]])
+                out[..., a, b] = (-1) ** (a + b) * minor
+    return out / det[..., None, None]
+
+
+def inverse_spd(M):
+    """Batched inverse of symmetric positive semi-definite matrices.
+
+    Returns ``(inverse, singular)``; singular matrices (normalised
+    determinant below :data:`SINGULAR_TOL`) are replaced by the identity so
+    the caller can report them and carry on with finite numbers.
+    """
+    q = M.shape[-1]
+    tr = np.trace(M, axis1=-2, axis2=-1) / q
+    s = np.where(tr > 0, tr, 1.0)
+    Mn = M / s[..., None, None]
+    det = _det(Mn)
+    singular = ~(det > SINGULAR_TOL)
+    eye = np.eye(q)
+    Mn = np.where(singular[..., None, None], eye, Mn)
+    if q <= 3:
+        inv = _inv_closed(Mn, np.where(singular, 1.0, det))
+    else:
+        inv = np.linalg.inv(Mn)
+    return inv / s[..., None, None], singular
+
+
+def raise_singular(x, fam_masters, fam_sizes, mem, k, j, what):
+    """Raise :class:`FamilyError` for family ``k`` (chunk-local index) and
+    evaluation member ``j`` (``None``: the master)."""
+    p = fam_masters[k]
+    msg = "family of {} ({} members): {} moment matrix".format(
+        describe_particle(p, x[:, p]), fam_sizes[k], what)
+    if j is not None and j > 0:
+        q = mem[k, j]
+        msg += " at member {}".format(describe_particle(q, x[:, q]))
+    msg += (" is singular: the members are too few or collinear/coplanar."
+            " Enlarge the family (larger horizon, more neighbours, or "
+            "families.from_mesh with a larger min_size).")
+    raise FamilyError(msg)

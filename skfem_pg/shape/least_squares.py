@@ -1,0 +1,44 @@
+r"""Weighted / moving least-squares shape functions.
+
+MLS1 *values at the master*, with the master's own weight excluded
+(:math:`\omega^{kk} = 0`; formulas.md section 3):
+
+.. math::
+
+    N_{MLS1}^{kki} = \omega^{ki} V^i \, p^{ki} \cdot (M^{kk})^{-1} \cdot e_0,
+    \qquad p^{ki} = (1, \Delta X^{ki}),
+    \qquad M^{kk} = \sum_{i\ne k} \omega^{ki} V^i p^{ki}\otimes p^{ki}.
+
+They reproduce linear fields, :math:`\sum_i N = 1` and
+:math:`\sum_i N\,\Delta X^{ki} = 0`, and build the VC correction functions V3
+and V5 (5.62), (5.64).  Needs ``dim + 1`` non-master members in general
+position.
+"""
+import numpy as np
+
+from .common import (FamilyGeometry, chunks, weights, inverse_spd,
+                     raise_singular)
+
+
+def mls1_master_values(x, volumes, fam, n=1):
+    """:math:`N_{MLS1}^{kki}`, shape ``(nf, m)`` (zero in padded slots and
+    at the master itself)."""
+    mem_all, mask_all = fam.padded()
+    nf, m = mem_all.shape
+    d = x.shape[0]
+    N = np.zeros((nf, m))
+    for sl in chunks(nf, m):
+        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
+        D = geo.D0
+        W = weights((D ** 2).sum(-1), n) * geo.V
+        p = np.concatenate([np.ones(D.shape[:2] + (1,)), D], axis=-1)
+        M = np.einsum("ki,kia,kib->kab", W, p, p)
+        Minv, singular = inverse_spd(M)
+        if np.any(singular):
+            k = np.nonzero(singular)[0][0]
+            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
+                           None, "MLS1 (master excluded, needs {} members "
+                           "besides the master in general position)"
+                           .format(d + 1))
+        N[sl] = W * np.einsum("kia,ka->ki", p, Minv[:, :, 0])
+    return N
