@@ -104,7 +104,7 @@ def _params(form, basis, kwargs):
 def _call(form, *args):
     try:
         return form.form(*args)
-    except (TypeError, AttributeError) as err:
+    except (TypeError, AttributeError, ValueError) as err:
         raise TypeError(
             "skfem_pg.assemble probes '{}' with value/gradient fields only "
             "and the form needs more ({}); assemble it with "

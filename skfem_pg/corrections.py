@@ -139,21 +139,62 @@ def _solve_lsqr(A, b, tol, maxiter):
     return out[0], int(out[2])
 
 
-def _solve_normal_direct(A, b, x, active):
-    """Min-norm solution via bordered normal equations
-    ``[[A Aᵀ, P], [Pᵀ, 0]] [y; λ] = [b; 0]``, ``α = Aᵀ y``, with ``P`` the
-    linear fields (null space of ``Aᵀ``), factorised by SuperLU."""
+def anchor_particles(x, active):
+    """``dim + 1`` active particles far apart and affinely independent
+    (farthest-point choice): their equations and unknowns pin the singular
+    constraint system."""
+    act = np.nonzero(active)[0]
+    X = x[:, act].T
+    d = X.shape[1]
+    chosen = [int(np.argmax(((X - X.mean(0)) ** 2).sum(1)))]
+    for _ in range(d):
+        B = X[chosen] - X[chosen[0]]
+        D = X - X[chosen[0]]
+        if len(chosen) > 1:  # distance to the affine hull of the chosen
+            Qb, _ = np.linalg.qr(B[1:].T)
+            D = D - (D @ Qb) @ Qb.T
+        chosen.append(int(np.argmax((D ** 2).sum(1))))
+    return act[chosen]
+
+
+def _solve_pinned_lu(A, b, x, active, family_of, refine=2):
+    """Min-norm solution of the consistent, singular, square system
+    ``A α = b`` with one sparse LU.
+
+    ``Pᵀ A = 0`` for the ``d + d²`` linear fields ``P``, so the equations at
+    ``d + 1`` affinely independent anchor particles follow from the others
+    and are dropped; the unknowns of the anchors' families are fixed to
+    zero.  The reduced sparse matrix is regular (else ``RuntimeError``).
+    Its LU gives a particular solution ``α_p`` and, with the fixed columns as
+    right-hand sides, a basis ``Z`` of the null space of ``A``; then
+    ``α = α_p - Z (ZᵀZ)⁻¹ Zᵀ α_p`` is the minimum-norm solution.
+    """
     d = x.shape[0]
-    rows = np.nonzero(np.repeat(active, d))[0]
-    Ar = A[rows]
-    S = (Ar @ Ar.T).tocsc()
-    P = linear_fields(x, active)[rows]
-    scale = S.diagonal().mean()
-    K = sp.bmat([[S, sp.csc_matrix(P * scale)],
-                 [sp.csc_matrix(P.T * scale), None]], format="csc")
-    rhs = np.concatenate([b[rows], np.zeros(P.shape[1])])
-    y = spl.splu(K, permc_spec="COLAMD").solve(rhs)[:len(rows)]
-    return Ar.T @ y, 1
+    n_rows, n_cols = A.shape
+    anchors = anchor_particles(x, active)
+    drop_rows = (d * anchors[:, None] + np.arange(d)).ravel()
+    fix_cols = (d * family_of[anchors][:, None] + np.arange(d)).ravel()
+    rows = np.setdiff1d(np.nonzero(np.repeat(active, d))[0], drop_rows)
+    cols = np.setdiff1d(np.arange(n_cols), fix_cols)
+    if len(rows) != len(cols):
+        raise RuntimeError("constraint system is not square ({} equations, "
+                           "{} unknowns)".format(len(rows), len(cols)))
+    Ar = A[rows].tocsc()
+    lu = spl.splu(Ar[:, cols], permc_spec="MMD_AT_PLUS_A")
+    rhs = np.column_stack([b[rows], -Ar[:, fix_cols].toarray()])
+    sol = lu.solve(rhs)
+    if not np.all(np.isfinite(sol)):
+        raise RuntimeError("the pinned constraint matrix is singular")
+    Z = np.zeros((n_cols, len(fix_cols)))
+    Z[cols] = sol[:, 1:]
+    Z[fix_cols, np.arange(len(fix_cols))] = 1.0
+    alpha = np.zeros(n_cols)
+    alpha[cols] = sol[:, 0]
+    for _ in range(refine):
+        r = b[rows] - Ar @ alpha
+        alpha[cols] += lu.solve(r)
+    coef = np.linalg.lstsq(Z, alpha, rcond=None)[0]
+    return alpha - Z @ coef, 1 + refine
 
 
 def _solve_normal_amg(A, b, x, active, tol, maxiter):
@@ -195,7 +236,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     variant
         ``"V5"`` (with bond projector, keeps the bond mapping) or ``"V3"``.
     solver
-        ``"direct"`` (bordered normal equations, SuperLU), ``"amg"``
+        ``"direct"`` (one sparse LU of the pinned system), ``"amg"``
         (normal equations, CG + smoothed aggregation), ``"lsqr"``
         (scipy LSQR) or ``"auto"``.
 
@@ -222,6 +263,12 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     A = constraint_matrix(phi, B, fam, n)
     r0 = constraint_residual(G, dx, fam, area)
     b = -r0.ravel()
+    # the part of b outside range(A) (e.g. volumes that do not add up to
+    # the enclosed volume) cannot be corrected: least squares drops it
+    P = linear_fields(x, active)
+    b = b - P @ (P.T @ b)
+    family_of = np.full(n, -1)
+    family_of[fam.masters] = np.arange(len(fam))
     if solver == "auto":
         solver = "direct" if A.shape[0] <= 400_000 else "amg"
     notes = []
@@ -229,7 +276,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         alpha, its = _solve_lsqr(A, b, tol, maxiter or 20 * A.shape[1])
     elif solver == "direct":
         try:
-            alpha, its = _solve_normal_direct(A, b, x, active)
+            alpha, its = _solve_pinned_lu(A, b, x, active, family_of)
         except RuntimeError as err:  # singular beyond the linear fields
             notes.append("direct solve failed ({}); fell back to LSQR"
                          .format(err))

@@ -218,12 +218,14 @@ def _active_tree(particles):
 def horizon(particles, delta=None, factor=1.51, min_size=None):
     r"""Families of all particles within the horizon ``delta``.
 
-    ``delta`` defaults to ``factor`` times the mean spacing
-    :math:`h = \overline{V}^{1/d}` (thesis: 1.51 h ... 3.01 h).
+    ``delta`` defaults to ``factor`` times the mean nearest-neighbour
+    distance ``h`` (the grid spacing of a regular node set; thesis:
+    1.51 h ... 3.01 h).
     """
     act, tree = _active_tree(particles)
     if delta is None:
-        delta = factor * particles.spacing
+        dist, _ = tree.query(particles.x[:, act].T, k=2)
+        delta = factor * float(np.mean(dist[:, 1]))
     if delta <= 0:
         raise FamilyError("the horizon must be positive, got {}".format(delta))
     pairs = tree.query_pairs(r=delta, output_type="ndarray")

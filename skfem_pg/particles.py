@@ -249,6 +249,13 @@ class Particles:
         out = np.zeros((self.dim, fb.N))
         for c in range(self.dim):
             out[c] = fem.LinearForm(lambda v, w: v * w.n[c]).assemble(fb)
+        # exact zeros off the facets (not round-off of the facet basis)
+        on = np.zeros(fb.N, dtype=bool)
+        if self.kind == "vertices":
+            on[self.mesh.facets[:, fb.find].ravel()] = True
+        else:
+            on[fb.tind] = True
+        out[:, ~on] = 0.0
         if self.kind == "centroids":
             out = out[:, self.elements]
         if facets is None:

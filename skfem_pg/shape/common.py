@@ -16,7 +16,7 @@ SINGULAR_TOL = 1e-10
 
 
 class FamilyGeometry:
-    """Normalised member positions and volumes of a chunk of families.
+    r"""Normalised member positions and volumes of a chunk of families.
 
     Attributes
     ----------

@@ -1,0 +1,84 @@
+"""The batched assembly equals scikit-fem's generic assembly."""
+import numpy as np
+import pytest
+import skfem as fem
+from skfem.helpers import dot, grad, ddot, sym_grad, transpose, mul
+
+import skfem_pg as pg
+from skfem_pg.models import lame, linear_elasticity
+from conftest import square, cube
+
+
+def rel(a, b):
+    a = a.toarray() if hasattr(a, "toarray") else a
+    b = b.toarray() if hasattr(b, "toarray") else b
+    return np.abs(a - b).max() / np.abs(b).max()
+
+
+@pytest.mark.parametrize("mesh", [square(5, 0.3), cube(2, 0.3)])
+def test_elasticity_fast_equals_generic(mesh):
+    d = mesh.dim()
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=d)
+    form = linear_elasticity(*lame(10.0, 0.3))
+    assert rel(pg.assemble(form, b), form.assemble(b)) < 1e-13
+
+
+def test_scalar_and_value_terms():
+    b = pg.FamilyBasis(pg.Particles.from_mesh(square(5, 0.3)))
+
+    @fem.BilinearForm
+    def helmholtz(u, v, w):
+        return dot(grad(u), grad(v)) + (1 + w.x[0] ** 2) * u * v \
+            + w.x[1] * u * grad(v)[0]
+
+    @fem.LinearForm
+    def load(v, w):
+        return np.sin(w.x[0]) * v + w.x[1] * grad(v)[1]
+
+    assert rel(pg.assemble(helmholtz, b), helmholtz.assemble(b)) < 1e-13
+    assert rel(pg.assemble(load, b), load.assemble(b)) < 1e-13
+
+
+def test_nonlinear_tangent_with_field_parameter():
+    mesh = square(4, 0.3)
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    rng = np.random.default_rng(0)
+    u0 = 0.05 * rng.normal(size=b.N)
+    F = b.interpolate(u0).grad + np.eye(2)[:, :, None, None]
+
+    @fem.BilinearForm
+    def tangent(du, v, w):  # St. Venant-Kirchhoff-like geometric part
+        S = mul(transpose(w.F), w.F)
+        return ddot(mul(grad(du), S), grad(v)) + \
+            ddot(mul(transpose(w.F), grad(du)), sym_grad(v))
+
+    @fem.LinearForm
+    def residual(v, w):
+        return ddot(w.F, grad(v))
+
+    assert rel(pg.assemble(tangent, b, F=F), tangent.assemble(b, F=F)) \
+        < 1e-13
+    assert rel(pg.assemble(residual, b, F=F), residual.assemble(b, F=F)) \
+        < 1e-13
+
+
+def test_interpolate_reproduces_linear_fields():
+    mesh = square(5, 0.3)
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    A = np.array([[0.1, -0.2], [0.3, 0.05]])
+    u = (A @ mesh.p).T.ravel()
+    f = b.interpolate(u)
+    mem, mask = b.families.padded()
+    assert np.abs((f.grad - A[:, :, None, None]) * mask).max() < 1e-12
+    assert np.allclose(np.asarray(f)[:, mask], (A @ mesh.p)[:, mem[mask]])
+
+
+def test_forms_needing_hessians_are_refused_by_fast_path():
+    b = pg.FamilyBasis(pg.Particles.from_mesh(square(3)))
+
+    @fem.BilinearForm
+    def biharmonic(u, v, w):
+        return ddot(u.hess, v.hess)
+
+    with pytest.raises(TypeError, match="form.assemble"):
+        pg.assemble(biharmonic, b)

@@ -1,0 +1,88 @@
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from conftest import square, cube
+
+
+@pytest.mark.parametrize("mesh", [square(6, 0.3), square(6, 0.3, kind="tri"),
+                                  cube(3, 0.3), cube(3, 0.3, kind="tet")])
+def test_lumped_volumes_and_area_vectors(mesh):
+    p = pg.Particles.from_mesh(mesh)
+    vol = fem.Functional(lambda w: 1.0 + 0 * w.x[0]).assemble(
+        fem.Basis(mesh, pg.particles.linear_elements(mesh)[0]))
+    assert p.volumes.sum() == pytest.approx(vol, rel=1e-12)
+    A = p.area_vectors()
+    # closed surface: sum A = 0, sum X (x) A = V I (divergence theorem)
+    assert np.abs(A.sum(axis=1)).max() < 1e-12
+    assert np.allclose(p.x @ A.T, vol * np.eye(mesh.dim()), atol=1e-12)
+    interior = np.setdiff1d(np.arange(mesh.nvertices), mesh.boundary_nodes())
+    assert np.abs(A[:, interior]).max() == 0.0
+
+
+def test_centroid_particles():
+    mesh = square(4, 0.2)
+    p = pg.Particles.from_mesh(mesh, kind="centroids")
+    assert p.n == mesh.nelements
+    assert p.volumes.sum() == pytest.approx(4.0)
+    A = p.area_vectors()
+    # element-indicator (P0) area vectors: closed surface, boundary elements
+    assert np.abs(A.sum(axis=1)).max() < 1e-12
+    boundary = np.unique(mesh.f2t[0, mesh.boundary_facets()])
+    inner = np.setdiff1d(np.arange(mesh.nelements), boundary)
+    assert np.all(A[:, inner] == 0) and np.all(np.any(A[:, boundary], 0))
+
+
+def test_subset_particles_keep_global_numbering():
+    mesh = square(4)
+    right = mesh.elements_satisfying(lambda x: x[0] > 0)
+    p = pg.Particles.from_mesh(mesh, elements=right)
+    assert p.n == mesh.nvertices
+    assert p.volumes.sum() == pytest.approx(2.0)
+    assert not p.active[np.nonzero(mesh.p[0] < -0.1)[0]].any()
+    # area vectors of the subdomain include the interface x = 0 (normal -x)
+    A = p.area_vectors()
+    iface = np.nonzero(np.isclose(mesh.p[0], 0) &
+                       (np.abs(mesh.p[1]) < 0.99))[0]
+    assert np.all(A[0, iface] < 0)
+
+
+def test_negative_volume_is_rejected():
+    with pytest.raises(pg.ParticleError, match=r"particle 1 at \(1, 0\)"):
+        pg.Particles(np.array([[0.0, 1.0], [0.0, 0.0]]), [1.0, -1.0])
+
+
+def test_zero_volume_is_rejected():
+    with pytest.raises(pg.ParticleError, match="volume 0"):
+        pg.Particles(np.array([[0.0, 1.0], [0.0, 0.0]]), [1.0, 0.0])
+
+
+def test_duplicates_are_rejected():
+    x = np.array([[0.0, 1.0, 1.0], [0.0, 0.0, 0.0]])
+    with pytest.raises(pg.ParticleError, match="particle 1 .* duplicates"):
+        pg.Particles(x, [1.0, 1.0, 1.0])
+
+
+def test_unsupported_meshes_are_rejected():
+    with pytest.raises(pg.UnsupportedMeshError, match="MeshTri2"):
+        pg.Particles.from_mesh(fem.MeshTri2.init_symmetric())
+    with pytest.raises(pg.UnsupportedMeshError, match="MeshLine1"):
+        pg.Particles.from_mesh(fem.MeshLine(np.linspace(0, 1, 5)))
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_degenerate_element_is_rejected():
+    p = np.array([[0.0, 1.0, 2.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+    t = np.array([[0, 1, 0], [1, 2, 1], [2, 3, 3]])  # first is flat
+    with pytest.raises(pg.ParticleError, match="element 0 .* degenerate"):
+        pg.Particles.from_mesh(fem.MeshTri(p, t))
+
+
+def test_gmsh_file(tmp_path):
+    mesh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"))
+    fn = str(tmp_path / "square.msh")
+    mesh.save(fn)
+    p = pg.Particles.from_file(fn)
+    assert p.n == mesh.nvertices
+    assert p.volumes.sum() == pytest.approx(4.0)

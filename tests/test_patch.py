@@ -1,0 +1,66 @@
+"""Linear patch test (thesis 7.1–7.2, Table 7.2)."""
+import numpy as np
+import pytest
+
+import skfem_pg as pg
+from skfem_pg.analysis import linear_patch_test
+from conftest import square, cube
+
+TOP = {2: lambda x: np.isclose(x[1], 1.0), 3: lambda x: np.isclose(x[2], 1.0)}
+
+
+def gmsh_triangles():
+    return pg.meshing.from_geo(pg.meshing.geo_path("square.geo"), size=0.2)
+
+
+MESHES_2D = {
+    "regular quads": lambda: square(10),
+    "distorted quads": lambda: square(10, 0.3, seed=1),
+    "distorted triangles": lambda: square(10, 0.3, seed=2, kind="tri"),
+    "gmsh triangles": gmsh_triangles,
+}
+MESHES_3D = {
+    "distorted hexes": lambda: cube(4, 0.3, seed=1),
+    "distorted tets": lambda: cube(4, 0.3, seed=2, kind="tet"),
+    "gmsh tets": lambda: pg.meshing.from_geo(pg.meshing.geo_path("cube.geo"),
+                                             size=0.3),
+}
+
+
+@pytest.mark.parametrize("name", list(MESHES_2D) + list(MESHES_3D))
+def test_vc_pbg_unl_passes(name):
+    mesh = {**MESHES_2D, **MESHES_3D}[name]()
+    r = linear_patch_test(mesh, TOP[mesh.dim()])  # MTE1 + BC + V5
+    assert r["max_error"] <= 1e-10
+    assert r["basis"].vc_report.residual_after < 1e-10
+
+
+@pytest.mark.parametrize("name", ["distorted quads", "distorted hexes"])
+@pytest.mark.parametrize("kw", [dict(vc=None), dict(shape="WTE1")])
+def test_uncorrected_fails(name, kw):
+    mesh = {**MESHES_2D, **MESHES_3D}[name]()
+    r = linear_patch_test(mesh, TOP[mesh.dim()], **kw)
+    # thesis Table 7.2: uncorrected PBG Unl eps_L2 = 8.6e-3
+    assert r["L2"] > 1e-3 and r["max_error"] > 1e-3
+
+
+def test_v3_without_bond_correction_passes():
+    r = linear_patch_test(square(8, 0.3, seed=4), TOP[2], bond=False,
+                          vc="V3")
+    assert r["max_error"] <= 1e-10
+
+
+def test_horizon_families_pass():
+    mesh = square(8, 0.3, seed=5)
+    p = pg.Particles.from_mesh(mesh)
+    fam = pg.families.horizon(p, factor=2.01)
+    r = linear_patch_test(mesh, TOP[2], particles=p, families=fam)
+    assert r["max_error"] <= 1e-10
+
+
+@pytest.mark.parametrize("solver", ["direct", "lsqr", "amg"])
+def test_vc_solvers_agree(solver):
+    r = linear_patch_test(square(8, 0.3, seed=6), TOP[2], vc_solver=solver)
+    rep = r["basis"].vc_report
+    assert rep.solver == solver
+    assert r["max_error"] <= 1e-10
