@@ -208,7 +208,11 @@ def _assemble_linear(form, basis, kwargs):
         Cs = np.broadcast_to(Cs, dx.shape + (nc * nch,)) \
             .reshape(dx.shape + (nc, nch))
         # f[k, l, c] = sum_j dx sum_γ C[k, j, c, γ] Ĝ[k, j, l, γ]
-        f = np.einsum("kj,kjcg,kjlg->klc", dx, Cs, Gh)
+        nfc = dx.shape[0]
+        X = (dx[..., None, None] * Cs).transpose(0, 2, 1, 3) \
+            .reshape(nfc, nc, m * nch)
+        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, m * nch, m)
+        f = np.swapaxes(X @ Gm, -1, -2)
         dofs = nc * mem[sl][:, :, None] + np.arange(nc)
         b += np.bincount(dofs.ravel(), weights=f.ravel(), minlength=basis.N)
     return b

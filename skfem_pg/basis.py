@@ -238,13 +238,13 @@ class FamilyBasis(AbstractBasis):
         if self.ncomp is None:
             U = w[mem]
             value = U * mask
-            grad = np.einsum("ki,kjid->dkj", U, self.G)
-            return DiscreteField(value, grad)
+            grad = (np.swapaxes(self.G, -1, -2) @ U[:, None, :, None])
+            return DiscreteField(value, np.moveaxis(grad[..., 0], -1, 0))
         nc = self.ncomp
         U = w.reshape(-1, nc)[mem]  # (nf, m, nc)
         value = np.moveaxis(U * mask[..., None], -1, 0)
-        grad = np.einsum("kic,kjid->cdkj", U, self.G)
-        return DiscreteField(value, grad)
+        grad = np.swapaxes(self.G, -1, -2) @ U[:, None]  # (nf, m, d, nc)
+        return DiscreteField(value, grad.transpose(3, 2, 0, 1))
 
     def global_coordinates(self):
         mem, _ = self.families.padded()

@@ -59,7 +59,7 @@ def bond_correction(G, x, fam):
     D0 = (P - P[:, :1, :]) * mask[..., None]
     L2 = (D0 ** 2).sum(-1)
     Q = bond_projectors(x, fam)
-    Gt = np.einsum("kjab,kjib->kjia", Q, G)
+    Gt = G @ Q  # Q symmetric: (Q G^i)_a = sum_b G^i_b Q_ba
     idx = np.arange(1, m)
     Gt[:, idx, idx, :] += np.where(
         mask[:, 1:, None], D0[:, 1:] / np.where(L2[:, 1:], L2[:, 1:],
@@ -73,8 +73,9 @@ def constraint_residual(G, dx, fam, area):
     r"""Integration-constraint residual (5.18),
     :math:`r^i = \sum_k\sum_j w_{kj} G^{kji} - A^i`, shape ``(np, d)``."""
     mem, _ = fam.padded()
-    S = np.einsum("kj,kjia->kia", dx, G)
-    n, d = area.shape[1], area.shape[0]
+    nf, m, _, d = G.shape
+    S = (dx[:, None, :] @ G.reshape(nf, m, m * d)).reshape(nf, m, d)
+    n = area.shape[1]
     r = np.stack([np.bincount(mem.ravel(), weights=S[..., a].ravel(),
                               minlength=n) for a in range(d)], axis=1)
     return r - area.T
@@ -259,7 +260,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         Q = bond_projectors(x, fam)
     else:
         Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
-    B = np.einsum("kj,kjab->kab", dx, Q)
+    nf, m = mem.shape
+    B = (dx[:, None, :] @ np.reshape(Q, (nf, m, d * d))).reshape(nf, d, d)
     A = constraint_matrix(phi, B, fam, n)
     r0 = constraint_residual(G, dx, fam, area)
     b = -r0.ravel()
@@ -289,7 +291,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         raise ValueError("unknown VC solver {!r}: use 'direct', 'amg', "
                          "'lsqr' or 'auto'".format(solver))
     alpha = alpha.reshape(-1, d)
-    C = np.einsum("ki,kjab,kb->kjia", phi, Q, alpha)
+    Qa = (Q @ alpha[:, None, :, None])[..., 0]  # (nf, m, d)
+    C = phi[:, None, :, None] * Qa[:, :, None, :]
     Gc = G + C * mask[:, :, None, None] * mask[:, None, :, None]
     r1 = constraint_residual(Gc, dx, fam, area)
     rep = VCReport(variant=variant, solver=solver, unknowns=A.shape[1],

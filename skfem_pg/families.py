@@ -134,7 +134,7 @@ def _needs_enlargement(x, fam, min_size):
     D = (P - c[:, None, :]) * others[..., None]
     h = np.maximum(np.abs(D).max(axis=(1, 2)), 1e-300)
     D = D / h[:, None, None]
-    S = np.einsum("kia,kib->kab", D, D)
+    S = np.swapaxes(D, -1, -2) @ D
     ev = np.linalg.eigvalsh(S)
     flat = ev[:, 0] <= 1e-8 * np.maximum(ev[:, -1], 1e-300)
     return small | flat

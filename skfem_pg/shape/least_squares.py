@@ -32,7 +32,7 @@ def mls1_master_values(x, volumes, fam, n=1):
         D = geo.D0
         W = weights((D ** 2).sum(-1), n) * geo.V
         p = np.concatenate([np.ones(D.shape[:2] + (1,)), D], axis=-1)
-        M = np.einsum("ki,kia,kib->kab", W, p, p)
+        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
         Minv, singular = inverse_spd(M)
         if np.any(singular):
             k = np.nonzero(singular)[0][0]
@@ -40,5 +40,5 @@ def mls1_master_values(x, volumes, fam, n=1):
                            None, "MLS1 (master excluded, needs {} members "
                            "besides the master in general position)"
                            .format(d + 1))
-        N[sl] = W * np.einsum("kia,ka->ki", p, Minv[:, :, 0])
+        N[sl] = W * (p @ Minv[:, :, :1])[..., 0]
     return N

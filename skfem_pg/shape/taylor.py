@@ -43,10 +43,11 @@ def wte1_gradients(x, volumes, fam, n=1):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
         W = weights((D ** 2).sum(-1), n) * geo.V  # master has r2 = 0
-        M = np.einsum("ki,kia,kib->kab", W, D, D)
+        WD = W[..., None] * D
+        M = np.swapaxes(WD, -1, -2) @ D
         Minv, singular = inverse_spd(M)
         _check(x, fam, sl, geo, singular, "WTE1", False)
-        g = np.einsum("ki,kab,kib->kia", W, Minv, D)
+        g = WD @ np.swapaxes(Minv, -1, -2)
         g[:, 0] = -g[:, 1:].sum(axis=1)
         g /= geo.h[:, None, None]
         G[sl] = g[:, None, :, :] * geo.mask[:, :, None, None]
@@ -68,10 +69,11 @@ def mte1_gradients(x, volumes, fam, n=1):
         pair = geo.mask[:, :, None] & geo.mask[:, None, :] & ~eye_m
         W = np.where(pair, weights((D ** 2).sum(-1), n)
                      * geo.V[:, None, :], 0.0)
-        M = np.einsum("kji,kjia,kjib->kjab", W, D, D)
+        WD = W[..., None] * D
+        M = np.swapaxes(WD, -1, -2) @ D
         Minv, singular = inverse_spd(M)
         _check(x, fam, sl, geo, singular & geo.mask, "MTE1", True)
-        g = np.einsum("kji,kjab,kjib->kjia", W, Minv, D)
+        g = WD @ np.swapaxes(Minv, -1, -2)  # G = W M^-1 D
         diag = g.sum(axis=2)  # G[k,j,j] = -sum_{i != j} G[k,j,i]
         g[:, np.arange(m), np.arange(m)] = -diag
         g /= geo.h[:, None, None, None]

@@ -1,0 +1,119 @@
+"""Preprocessing, assembly and solve: VC PBG Unl against scikit-fem Q1 on the
+same ±0.3h distorted quad node sets, 10k to 250k particles, in one run.
+
+Reports per size: PG preprocessing split (particles, families, gradients,
+bond, VC), PG assembly (fast path, first call with the sparsity pattern and
+repeated), scikit-fem Q1 assembly and solve, and the ratios
+PG-assembly / Q1-assembly and preprocessing / Q1-solve.  Absolute times
+drift between machines; the ratios are the result.
+
+    python benchmarks/assembly_scaling.py [--sizes 100 200 300 400 500]
+
+(``--sizes`` are elements per side: 101² ≈ 10k ... 501² ≈ 250k particles.)
+"""
+import argparse
+import json
+import os
+import time
+
+import numpy as np
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg.models import lame, linear_elasticity
+
+OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+FORM = linear_elasticity(*lame(1.0, 0.3))
+
+
+def clock(fn, *args, **kw):
+    t0 = time.perf_counter()
+    out = fn(*args, **kw)
+    return out, time.perf_counter() - t0
+
+
+def run(n, generic=False, pg_solve=False):
+    mesh = pg.meshing.distort(
+        fem.MeshQuad.init_tensor(*[np.linspace(0, 1, n + 1)] * 2), 0.3,
+        seed=n)
+    r = {"n": n, "particles": int(mesh.nvertices)}
+    # --- scikit-fem Q1 -------------------------------------------------
+    q1, r["q1_basis"] = clock(fem.Basis, mesh,
+                              fem.ElementVector(fem.ElementQuad1()))
+    Kq, r["q1_assemble"] = clock(FORM.assemble, q1)
+    f = q1.zeros()
+    f[q1.get_dofs(lambda x: np.isclose(x[0], 1)).nodal["u^2"]] = 1.0 / n
+    D = q1.get_dofs(lambda x: np.isclose(x[0], 0))
+    uq, r["q1_solve"] = clock(lambda: fem.solve(*fem.condense(Kq, f, D=D)))
+    r["q1_nnz"] = int(Kq.nnz)
+    # --- PG ------------------------------------------------------------
+    t0 = time.perf_counter()
+    particles, r["pg_particles"] = clock(pg.Particles.from_mesh, mesh)
+    basis = pg.FamilyBasis(particles, dim=2)
+    r["pg_preprocess"] = time.perf_counter() - t0
+    for k, v in basis.timings.items():
+        r["pg_" + k] = v
+    r["vc_residual_after"] = basis.vc_report.residual_after
+    K, r["pg_assemble_first"] = clock(pg.assemble, FORM, basis)
+    K, r["pg_assemble"] = clock(pg.assemble, FORM, basis)
+    r["pg_nnz"] = int(K.nnz)
+    if generic:
+        basis._basis = None
+        Kg, r["pg_assemble_generic"] = clock(FORM.assemble, basis)
+        r["generic_vs_fast"] = float(abs(Kg - K).max() / abs(K).max())
+    if pg_solve:
+        u, r["pg_solve"] = clock(lambda: fem.solve(*fem.condense(K, f, D=D)))
+        r["tip_pg_vs_q1"] = float(u[-1] / uq[-1])
+    r["ratio_asm"] = r["pg_assemble"] / r["q1_assemble"]
+    r["ratio_asm_first"] = r["pg_assemble_first"] / r["q1_assemble"]
+    r["ratio_pre_q1solve"] = r["pg_preprocess"] / r["q1_solve"]
+    return r
+
+
+def main(sizes):
+    rows = []
+    hdr = ("{:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s}"
+           " {:>8s} {:>8s} {:>9s} {:>9s}")
+    print(hdr.format("np", "pre[s]", "fam", "grad", "bond", "vc", "asm1st",
+                     "asm", "Q1asm", "Q1solve", "PGsolve", "asm/Q1",
+                     "pre/Q1slv"))
+    for n in sizes:
+        r = run(n, generic=n <= 100, pg_solve=n <= 300)
+        rows.append(r)
+        print("{:8d} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} "
+              "{:8.2f} {:8.2f} {:>8s} {:9.2f} {:9.2f}".format(
+                  r["particles"], r["pg_preprocess"], r["pg_families"],
+                  r["pg_gradients"], r["pg_bond"], r["pg_vc"],
+                  r["pg_assemble_first"], r["pg_assemble"],
+                  r["q1_assemble"], r["q1_solve"],
+                  "{:.2f}".format(r["pg_solve"]) if "pg_solve" in r else "-",
+                  r["ratio_asm"], r["ratio_pre_q1solve"]), flush=True)
+    for a, b in zip(rows, rows[1:]):
+        g = np.log(b["particles"] / a["particles"])
+        print("growth exponent {:6d} -> {:6d}: preprocess {:.2f}, VC {:.2f},"
+              " PG asm {:.2f}, Q1 asm {:.2f}, Q1 solve {:.2f}".format(
+                  a["particles"], b["particles"],
+                  np.log(b["pg_preprocess"] / a["pg_preprocess"]) / g,
+                  np.log(b["pg_vc"] / a["pg_vc"]) / g,
+                  np.log(b["pg_assemble"] / a["pg_assemble"]) / g,
+                  np.log(b["q1_assemble"] / a["q1_assemble"]) / g,
+                  np.log(b["q1_solve"] / a["q1_solve"]) / g))
+    if rows and "pg_assemble_generic" in rows[0]:
+        r = rows[0]
+        print("generic scikit-fem path on PG at {} particles: {:.2f} s "
+              "({:.1f}x the fast path; max rel. difference {:.1e})".format(
+                  r["particles"], r["pg_assemble_generic"],
+                  r["pg_assemble_generic"] / r["pg_assemble"],
+                  r["generic_vs_fast"]))
+    os.makedirs(OUT, exist_ok=True)
+    with open(os.path.join(OUT, "assembly_scaling.json"), "w") as fh:
+        json.dump(rows, fh, indent=1)
+    print("wrote benchmarks/out/assembly_scaling.json")
+    return rows
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="+",
+                    default=[100, 200, 300, 400, 500])
+    main(ap.parse_args().sizes)
