@@ -107,6 +107,11 @@ class FamilyBasis(AbstractBasis):
         if vc == "V5" and not bond:
             raise ValueError("vc='V5' keeps the bond mapping and needs "
                              "bond=True; use vc='V3' without bond correction")
+        if vc is not None and area_vectors is None and particles.mesh is None:
+            raise ValueError(
+                "the VC correction needs surface area vectors A^i: these "
+                "particles have no mesh, so pass area_vectors= (shape "
+                "(dim, n)) or use vc=None")
         self.particles = particles
         self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
         self.weight_exponent = weight_exponent

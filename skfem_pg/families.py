@@ -142,17 +142,26 @@ def _needs_enlargement(x, fam, min_size):
 
 def _complete(x, A, masters, min_size, max_rings=3):
     """Build families from ``A`` and enlarge the deficient ones ring by
-    ring."""
+    ring; families the rings cannot fix (isolated clusters) get their
+    ``min_size + dim`` nearest neighbours among the masters."""
     fam = Families.from_adjacency(A, masters)
     A = A.tocsr().astype(bool)
-    for _ in range(max_rings):
+    for ring in range(max_rings + 1):
         need = _needs_enlargement(x, fam, min_size)
         if not np.any(need):
             break
         rows = masters[need]
-        R = sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, rows)),
-                          shape=A.shape)
-        A = (A + R @ A @ A).astype(bool)
+        if ring < max_rings:
+            R = sp.csr_matrix((np.ones(len(rows), dtype=bool),
+                               (rows, rows)), shape=A.shape)
+            A = (A + R @ A @ A).astype(bool)
+        else:
+            k = min(min_size + x.shape[0], len(masters))
+            _, nb = cKDTree(x[:, masters].T).query(x[:, rows].T, k=k)
+            A = (A + sp.csr_matrix(
+                (np.ones(nb.size, dtype=bool),
+                 (np.repeat(rows, k), masters[nb.ravel()])),
+                shape=A.shape)).astype(bool)
         fam = Families.from_adjacency(A, masters)
     return fam
 

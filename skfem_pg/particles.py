@@ -237,29 +237,60 @@ class Particles:
 
         over the boundary of the particles' region (default; for a subdomain
         this includes the interface with the rest of the mesh, with normals
-        pointing out of the subdomain) or over the given ``facets``.  For
-        centroid particles :math:`N_i` is the element indicator.  Interior
-        particles get :math:`A^i = 0`.  Used as the right-hand side of the
+        pointing out of the subdomain) or over the given ``facets``.
+        Vertex particles use the mesh's P1/Q1 functions :math:`N_i`; interior
+        particles get :math:`A^i = 0`.  Centroid particles have no surface
+        particles: :math:`N_i` are then MLS1 functions of the nearest
+        ``3·dim`` particles at the facet quadrature points, which reproduce
+        linear fields, so that :math:`\sum_i X^i\otimes A^i = V\,I` as the
+        integration constraint requires.  Used as the right-hand side of the
         integration constraint (5.18) and for Neumann loads.
         """
         if facets is None and self._area_vectors is not None:
             return self._area_vectors
         self._need_mesh("area vectors")
+        if self.kind == "centroids":
+            out = self._mls_area_vectors(facets)
+            if facets is None:
+                self._area_vectors = out
+            return out
         fb = self._facet_basis(facets)
         out = np.zeros((self.dim, fb.N))
         for c in range(self.dim):
             out[c] = fem.LinearForm(lambda v, w: v * w.n[c]).assemble(fb)
         # exact zeros off the facets (not round-off of the facet basis)
         on = np.zeros(fb.N, dtype=bool)
-        if self.kind == "vertices":
-            on[self.mesh.facets[:, fb.find].ravel()] = True
-        else:
-            on[fb.tind] = True
+        on[self.mesh.facets[:, fb.find].ravel()] = True
         out[:, ~on] = 0.0
-        if self.kind == "centroids":
-            out = out[:, self.elements]
         if facets is None:
             self._area_vectors = out
+        return out
+
+    def _mls_area_vectors(self, facets=None):
+        from .shape import mls1_values
+        e1, _ = linear_elements(self.mesh)
+        elements = self.elements
+        if facets is None:
+            facets = self.mesh.facets_around(elements)
+        else:
+            facets = self.mesh.normalize_facets(facets)
+        fb = fem.FacetBasis(self.mesh, e1, facets=facets, intorder=3)
+        xq = np.asarray(fb.global_coordinates()).reshape(self.dim, -1).T
+        ndg = (np.asarray(fb.normals) * fb.dx[None]).reshape(self.dim, -1)
+        k = min(3 * self.dim, self.n)
+        _, nb = cKDTree(self.x.T).query(xq, k=k)
+        D = self.x.T[nb] - xq[:, None, :]
+        h = np.sqrt((D ** 2).sum(-1).max(axis=1))
+        N, singular = mls1_values(D / h[:, None, None], self.volumes[nb])
+        if np.any(singular):
+            q = np.nonzero(singular)[0][0]
+            raise ParticleError("MLS1 at boundary point {} is singular: its "
+                                "{} nearest particles are collinear/coplanar"
+                                .format(tuple(np.round(xq[q], 6)), k))
+        out = np.zeros((self.dim, self.n))
+        for c in range(self.dim):
+            out[c] = np.bincount(nb.ravel(), weights=(N * ndg[c][:, None])
+                                 .ravel(), minlength=self.n)
         return out
 
     def _facet_basis(self, facets=None, vector=False):

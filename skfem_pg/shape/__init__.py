@@ -1,7 +1,7 @@
 """Batched shape-function derivatives over all families (no per-family
 Python loop).  One module per construction."""
 from .taylor import wte1_gradients, mte1_gradients
-from .least_squares import mls1_master_values
+from .least_squares import mls1_master_values, mls1_values
 
 #: shape-function derivative builders by name (thesis Table 5.1)
 GRADIENTS = {
@@ -10,4 +10,5 @@ GRADIENTS = {
 }
 
 __all__ = ["wte1_gradients", "mte1_gradients", "mls1_master_values",
+           "mls1_values",
            "GRADIENTS"]

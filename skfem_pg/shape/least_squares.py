@@ -20,6 +20,19 @@ from .common import (FamilyGeometry, chunks, weights, inverse_spd,
                      raise_singular)
 
 
+def mls1_values(D, V, n=1):
+    r"""MLS1 values from offsets ``D = (X^i - x)/h`` (``(..., k, d)``) and
+    volumes ``V`` (``(..., k)``; 0 for unused slots) of the support
+    particles of evaluation points ``x``: :math:`N^i = \omega^i V^i p^i\cdot
+    M^{-1} e_0`.  Offsets of length 0 get weight 0.  Returns ``(N,
+    singular)``."""
+    W = weights((D ** 2).sum(-1), n) * V
+    p = np.concatenate([np.ones(D.shape[:-1] + (1,)), D], axis=-1)
+    M = np.swapaxes(W[..., None] * p, -1, -2) @ p
+    Minv, singular = inverse_spd(M)
+    return W * (p @ Minv[..., :, :1])[..., 0], singular
+
+
 def mls1_master_values(x, volumes, fam, n=1):
     """:math:`N_{MLS1}^{kki}`, shape ``(nf, m)`` (zero in padded slots and
     at the master itself)."""
@@ -29,16 +42,11 @@ def mls1_master_values(x, volumes, fam, n=1):
     N = np.zeros((nf, m))
     for sl in chunks(nf, m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        D = geo.D0
-        W = weights((D ** 2).sum(-1), n) * geo.V
-        p = np.concatenate([np.ones(D.shape[:2] + (1,)), D], axis=-1)
-        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
-        Minv, singular = inverse_spd(M)
+        N[sl], singular = mls1_values(geo.D0, geo.V, n)
         if np.any(singular):
             k = np.nonzero(singular)[0][0]
             raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
                            None, "MLS1 (master excluded, needs {} members "
                            "besides the master in general position)"
                            .format(d + 1))
-        N[sl] = W * (p @ Minv[:, :, :1])[..., 0]
     return N

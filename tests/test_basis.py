@@ -1,0 +1,96 @@
+"""FamilyBasis as a scikit-fem basis: functionals, loads, dofs, particle
+kinds."""
+import numpy as np
+import pytest
+import skfem as fem
+from skfem.helpers import ddot, sym_grad
+
+import skfem_pg as pg
+from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
+from skfem_pg.corrections import anchor_particles
+from skfem_pg.models import lame, linear_elasticity
+from conftest import square
+
+
+def test_functional_integrates_exactly_for_linear_fields():
+    mesh = square(6, 0.3)
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    u = (GEX @ mesh.p).T.ravel()
+    energy = fem.Functional(lambda w: ddot(sym_grad(w.u), sym_grad(w.u)))
+    eps = 0.5 * (GEX + GEX.T)
+    assert energy.assemble(b, u=b.interpolate(u)) == pytest.approx(
+        4.0 * np.sum(eps * eps), rel=1e-12)
+    area = fem.Functional(lambda w: 1.0 + 0.0 * w.x[0]).assemble(b)
+    assert area == pytest.approx(4.0, rel=1e-12)
+
+
+def test_body_force_and_traction_totals():
+    mesh = square(5, 0.2).with_boundaries(
+        {"top": lambda x: np.isclose(x[1], 1)})
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    fb = pg.body_force(b, [0.0, -9.81], rho=2.0)
+    assert fb.reshape(-1, 2).sum(axis=0) == pytest.approx([0, -2 * 9.81 * 4])
+    ft = pg.traction(b, "top", [1.0, 0.5])
+    assert ft.reshape(-1, 2).sum(axis=0) == pytest.approx([2.0, 1.0])
+    fx = pg.traction(b, "top", lambda x: np.array([x[0], 0 * x[0]]))
+    assert fx.reshape(-1, 2).sum(axis=0) == pytest.approx([0.0, 0.0],
+                                                           abs=1e-14)
+
+
+def test_get_dofs_matches_scikit_fem_numbering():
+    mesh = square(4).with_boundaries({"left": lambda x: np.isclose(x[0], -1)})
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+    assert np.array_equal(b.get_dofs("left").flatten(),
+                          fe.get_dofs("left").flatten())
+    assert np.array_equal(b.get_dofs().flatten(), fe.get_dofs().flatten())
+    scalar = pg.FamilyBasis(pg.Particles.from_mesh(mesh))
+    assert scalar.N == mesh.nvertices
+    assert np.array_equal(scalar.get_dofs("left").flatten(),
+                          fem.Basis(mesh, fem.ElementQuad1())
+                          .get_dofs("left").flatten())
+
+
+@pytest.mark.parametrize("kind", ["quad", "tri"])
+def test_centroid_particles_pass_the_patch_test(kind):
+    mesh = square(10, 0.3, seed=1, kind=kind)
+    p = pg.Particles.from_mesh(mesh, kind="centroids")
+    A = p.area_vectors()
+    assert np.allclose(p.x @ A.T, 4.0 * np.eye(2), atol=1e-12)
+    lam, mu = lame(100.0, 0.3)
+    eps = 0.5 * (GEX + GEX.T)
+    sigma = 2 * mu * eps + lam * np.trace(eps) * np.eye(2)
+    uex = (GEX @ p.x).T.ravel()
+    errors = []
+    for kw in ({}, {"vc": None}):
+        b = pg.FamilyBasis(p, dim=2, **kw)
+        K = pg.assemble(linear_elasticity(lam, mu), b)
+        f = (sigma @ A).T.ravel()  # pure Neumann, rigid modes pinned
+        D = b.get_dofs(nodes=anchor_particles(p.x, p.active))
+        u = fem.solve(*fem.condense(K, f, x=uex, D=D))
+        errors.append(np.abs(u - uex).max())
+    assert errors[0] <= 1e-10 and errors[1] > 1e-3
+
+
+def test_points_without_mesh_need_area_vectors_for_vc():
+    rng = np.random.default_rng(0)
+    p = pg.Particles(rng.uniform(0, 1, (2, 50)), np.full(50, 0.02))
+    with pytest.raises(ValueError, match="area_vectors="):
+        pg.FamilyBasis(p, dim=2)
+    b = pg.FamilyBasis(p, dim=2, vc=None)  # horizon families by default
+    assert b.families.sizes.min() >= 4
+    with pytest.raises(ValueError, match="nodes="):
+        b.get_dofs()
+    assert np.array_equal(b.get_dofs(nodes=[3]), [6, 7])
+
+
+def test_bad_options_are_named():
+    p = pg.Particles.from_mesh(square(3))
+    with pytest.raises(NotImplementedError, match="PPG1"):
+        pg.FamilyBasis(p, method="PPG1")
+    with pytest.raises(ValueError, match="MTE2"):
+        pg.FamilyBasis(p, shape="MTE2")
+    with pytest.raises(ValueError, match="bond=True"):
+        pg.FamilyBasis(p, bond=False, vc="V5")
+    with pytest.raises(ValueError, match="V2"):
+        pg.FamilyBasis(p, vc="V2")
