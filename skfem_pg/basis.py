@@ -68,8 +68,8 @@ class FamilyBasis(AbstractBasis):
     weight_exponent
         ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}` (default 1).
     vc_solver
-        Solver of the VC constraint system: ``"auto"``, ``"direct"``,
-        ``"amg"`` or ``"lsqr"``.
+        Solver of the VC constraint system: ``"auto"`` = ``"direct"``
+        (scalar sparse LU) or ``"lsqr"``.
     area_vectors
         ``(dim, np)`` surface area vectors :math:`A^i`; default: the
         FE-consistent ones of ``particles.area_vectors()``.
