@@ -31,6 +31,7 @@ from skfem.assembly.form.form import FormExtraParams
 from skfem.element import DiscreteField
 
 from .basis import FamilyBasis
+from .shape.common import chunks
 
 
 def _probes(basis):
@@ -96,9 +97,13 @@ def _used_channels(C, nc, nch, axis_is_pair=True):
     return used or [1]
 
 
-def _params(form, basis, kwargs):
-    return FormExtraParams({**basis.default_parameters(),
-                            **form._normalize_asm_kwargs(kwargs, basis)})
+def _setup(form, basis, kwargs):
+    """``w``, probes and sizes shared by the bilinear and linear paths."""
+    w = FormExtraParams({**basis.default_parameters(),
+                         **form._normalize_asm_kwargs(kwargs, basis)})
+    nf, m = basis.families.padded()[0].shape
+    nc = 1 if basis.ncomp is None else basis.ncomp
+    return w, _probes(basis), nf, m, nc, basis.particles.dim + 1
 
 
 def _call(form, *args):
@@ -110,11 +115,6 @@ def _call(form, *args):
             "and the form needs more ({}); assemble it with "
             "form.assemble(basis) instead".format(form.form.__name__, err)) \
             from err
-
-
-def _chunks(nf, per_family, budget=2 ** 24):
-    step = max(1, budget // max(1, per_family))
-    return [slice(a, min(a + step, nf)) for a in range(0, nf, step)]
 
 
 def block_pattern(basis):
@@ -135,25 +135,20 @@ def block_pattern(basis):
         S.sort_indices()
         rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(S.indptr))
         keys = rows * n + S.indices
-        chunks = []
-        for sl in _chunks(nf, m * m * nc * nc * (basis.particles.dim + 1)):
+        pieces = []
+        for sl in chunks(nf, m * m * nc * nc * (basis.particles.dim + 1),
+                         budget=2 ** 24):
             loc = (mem[sl, :, None].astype(np.int64) * n
                    + mem[sl, None, :]).ravel()
             u, inv = np.unique(np.searchsorted(keys, loc),
                                return_inverse=True)
-            chunks.append((sl, u, inv.astype(np.int64)))
-        basis._pattern = (S.indptr.copy(), S.indices.copy(), chunks)
+            pieces.append((sl, u, inv.astype(np.int64)))
+        basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces)
     return basis._pattern
 
 
 def _assemble_bilinear(form, basis, kwargs):
-    w = _params(form, basis, kwargs)
-    probes = _probes(basis)
-    mem, mask = basis.families.padded()
-    nf, m = mem.shape
-    nc = 1 if basis.ncomp is None else basis.ncomp
-    d = basis.particles.dim
-    nch = d + 1
+    w, probes, nf, m, nc, nch = _setup(form, basis, kwargs)
     # C[p, q]: p = trial probe (a, β), q = test probe (c, γ)
     values = [[_call(form, pu, pv, w) for (_, _, pv) in probes]
               for (_, _, pu) in probes]
@@ -162,9 +157,9 @@ def _assemble_bilinear(form, basis, kwargs):
     sel = [a * nch + b for a in range(nc) for b in ch]
     C = C[..., sel, :][..., :, sel]
     nb = len(ch)
-    indptr, indices, chunks = block_pattern(basis)
+    indptr, indices, pieces = block_pattern(basis)
     data = np.zeros((len(indices), nc, nc))
-    for sl, u, inv in chunks:
+    for sl, u, inv in pieces:
         Gh = _extended_gradients(basis, sl, ch)  # (k, j, i, β)
         X = Gh * basis.dx[sl][:, :, None, None]
         nfc = X.shape[0]
@@ -191,17 +186,13 @@ def _assemble_bilinear(form, basis, kwargs):
 
 
 def _assemble_linear(form, basis, kwargs):
-    w = _params(form, basis, kwargs)
-    probes = _probes(basis)
-    mem, mask = basis.families.padded()
-    nf, m = mem.shape
-    nc = 1 if basis.ncomp is None else basis.ncomp
-    nch = basis.particles.dim + 1
+    w, probes, nf, m, nc, nch = _setup(form, basis, kwargs)
+    mem = basis.families.padded()[0]
     values = [[_call(form, pv, w) for (_, _, pv) in probes]]
     C, const = _coefficients(values, (nf, m))
     C = C[..., 0, :]  # (P,) or (nf, m, P)
     b = np.zeros(basis.N)
-    for sl in _chunks(nf, m * m * nc * nch):
+    for sl in chunks(nf, m * m * nc * nch, budget=2 ** 24):
         Gh = _extended_gradients(basis, sl, range(nch))
         dx = basis.dx[sl]
         Cs = C if const else C[sl]

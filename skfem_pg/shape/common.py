@@ -43,10 +43,10 @@ class FamilyGeometry:
                                                               keepdims=True))
 
 
-def chunks(nf, m, budget=2 ** 22):
-    """Slices over families such that ``chunk * m * m`` stays near
-    ``budget``."""
-    step = max(1, budget // max(1, m * m))
+def chunks(nf, per_family, budget=2 ** 22):
+    """Slices over ``nf`` families such that ``chunk * per_family`` stays
+    near ``budget`` (array entries)."""
+    step = max(1, budget // max(1, per_family))
     return [slice(a, min(a + step, nf)) for a in range(0, nf, step)]
 
 

@@ -40,7 +40,7 @@ def mls1_master_values(x, volumes, fam, n=1):
     nf, m = mem_all.shape
     d = x.shape[0]
     N = np.zeros((nf, m))
-    for sl in chunks(nf, m):
+    for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         N[sl], singular = mls1_values(geo.D0, geo.V, n)
         if np.any(singular):

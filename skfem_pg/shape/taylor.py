@@ -39,7 +39,7 @@ def wte1_gradients(x, volumes, fam, n=1):
     nf, m = mem_all.shape
     d = x.shape[0]
     G = np.zeros((nf, m, m, d))
-    for sl in chunks(nf, m):
+    for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
         W = weights((D ** 2).sum(-1), n) * geo.V  # master has r2 = 0
@@ -62,7 +62,7 @@ def mte1_gradients(x, volumes, fam, n=1):
     d = x.shape[0]
     G = np.zeros((nf, m, m, d))
     eye_m = np.eye(m, dtype=bool)
-    for sl in chunks(nf, m):
+    for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         P = geo.D0
         D = P[:, None, :, :] - P[:, :, None, :]  # D[k,j,i] = X^i - X^j
