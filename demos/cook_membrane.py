@@ -16,7 +16,7 @@ Methods on the same nodes (regular and ±0.3h distorted node sets):
 Prints a table (error, preprocess / assemble / solve seconds) and writes
 demos/out/cook_membrane.png and a VTU of the finest VC PBG Unl solution.
 
-    python demos/cook_membrane.py [--max-n 64]
+    python demos/cook_membrane.py [--max-n 128]
 """
 import argparse
 import json
@@ -106,7 +106,7 @@ def solve_pg(mesh, kw):
     return u, (t1 - t0, t2 - t1, t3 - t2), b
 
 
-def main(max_n=32):
+def main(max_n=64):
     ref = reference()
     print("reference v(48,52) = {:.5f} (Q2 overkill; literature {})"
           .format(ref, LITERATURE))
@@ -173,6 +173,6 @@ def plot(rows, ref, fn):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--max-n", type=int, default=32,
-                    help="finest elements per side (even; default 32)")
+    ap.add_argument("--max-n", type=int, default=64,
+                    help="finest elements per side (even; default 64)")
     main(ap.parse_args().max_n)

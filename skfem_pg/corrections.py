@@ -37,36 +37,39 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 
+def bond_directions(x, fam):
+    """Unit bonds ``e[k, j]`` master → member ``j`` and squared lengths
+    ``L2[k, j]``; ``e = 0`` at the master and in padded slots."""
+    mem, mask = fam.padded()
+    P = x.T[mem]
+    D0 = (P - P[:, :1, :]) * mask[..., None]
+    L2 = (D0 ** 2).sum(-1)
+    ok = L2 > 0
+    e = D0 / np.sqrt(np.where(ok, L2, 1.0))[..., None]
+    return e, L2
+
+
 def bond_projectors(x, fam):
     r"""``Q[k, j] = I - e⊗e`` with ``e`` the unit bond master→member ``j``;
     identity at the master and in padded slots.  Shape ``(nf, m, d, d)``."""
-    mem, mask = fam.padded()
-    d = x.shape[0]
-    P = x.T[mem]
-    D0 = (P - P[:, :1, :])
-    L2 = (D0 ** 2).sum(-1)
-    ok = mask & (L2 > 0)
-    e = np.where(ok[..., None], D0 / np.sqrt(np.where(ok, L2, 1.0))[..., None],
-                 0.0)
-    return np.eye(d) - e[..., :, None] * e[..., None, :]
+    e, _ = bond_directions(x, fam)
+    return np.eye(x.shape[0]) - e[..., :, None] * e[..., None, :]
 
 
 def bond_correction(G, x, fam):
     """Bond-corrected derivatives (5.55), shape of ``G``."""
     mem, mask = fam.padded()
     m = mem.shape[1]
-    P = x.T[mem]
-    D0 = (P - P[:, :1, :]) * mask[..., None]
-    L2 = (D0 ** 2).sum(-1)
-    Q = bond_projectors(x, fam)
-    Gt = G @ Q  # Q symmetric: (Q G^i)_a = sum_b G^i_b Q_ba
+    e, L2 = bond_directions(x, fam)
+    # Q G = G - (G·e) e, e = 0 on the master row (Q^{kk} = I)
+    Gt = G - (G * e[:, :, None, :]).sum(-1)[..., None] * e[:, :, None, :]
     idx = np.arange(1, m)
-    Gt[:, idx, idx, :] += np.where(
-        mask[:, 1:, None], D0[:, 1:] / np.where(L2[:, 1:], L2[:, 1:],
-                                                1.0)[..., None], 0.0)
-    Gt[:, :, 0] = -Gt[:, :, 1:].sum(axis=2)
-    Gt[:, 0] = G[:, 0]  # Q^{kk} = I: the master row is unchanged
-    return Gt * mask[:, :, None, None] * mask[:, None, :, None]
+    Gt[:, idx, idx, :] += e[:, 1:] / np.sqrt(np.where(L2[:, 1:] > 0,
+                                                      L2[:, 1:],
+                                                      1.0))[..., None]
+    Gt[:, 1:, 0] = -Gt[:, 1:, 1:].sum(axis=2)
+    Gt *= mask[:, :, None, None] & mask[:, None, :, None]
+    return Gt
 
 
 def constraint_residual(G, dx, fam, area):
@@ -291,9 +294,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         raise ValueError("unknown VC solver {!r}: use 'direct', 'lsqr' or "
                          "'auto'".format(solver))
     alpha = alpha.reshape(-1, d)
-    Qa = (Q @ alpha[:, None, :, None])[..., 0]  # (nf, m, d)
-    C = phi[:, None, :, None] * Qa[:, :, None, :]
-    Gc = G + C * mask[:, :, None, None] * mask[:, None, :, None]
+    Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]  # (nf,m,d)
+    Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # phi is 0 if padded
     r1 = constraint_residual(Gc, dx, fam, area)
     rep = VCReport(variant=variant, solver=solver, unknowns=A.shape[1],
                    constraints=int(active.sum()) * d,
