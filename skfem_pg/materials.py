@@ -1,0 +1,202 @@
+r"""Hyperelastic materials as functions of the deformation gradient.
+
+Each material maps ``F`` of shape ``(d, d, ...)`` (any trailing axes, e.g.
+families × members or elements × quadrature points) to the first
+Piola–Kirchhoff stress :math:`P = \partial W/\partial F` (2.41), shape
+``(d, d, ...)``, and the consistent tangent
+:math:`\mathbb A_{iJkL} = \partial P_{iJ}/\partial F_{kL}`, shape
+``(d, d, d, d, ...)``.  In 2-D the models are plane strain (the third
+stretch is 1) except :class:`LinearElastic` with ``plane_stress=True``.
+
+Tangents are verified against central finite differences in
+``tests/test_materials.py``.
+"""
+import numpy as np
+
+
+def _inv_det(F):
+    """Inverse and determinant of ``(d, d, ...)`` arrays."""
+    Fm = np.moveaxis(F, (0, 1), (-2, -1))
+    return np.moveaxis(np.linalg.inv(Fm), (-2, -1), (0, 1)), np.linalg.det(Fm)
+
+
+def _eye(F):
+    d = F.shape[0]
+    return np.eye(d).reshape((d, d) + (1,) * (F.ndim - 2))
+
+
+def _dyad(A, B):
+    """:math:`(A\\otimes B)_{iJkL} = A_{iJ} B_{kL}`."""
+    return A[:, :, None, None] * B[None, None]
+
+
+def _inv_t_derivative(Finv):
+    r""":math:`\partial F^{-T}_{iJ}/\partial F_{kL} = -F^{-1}_{Jk}F^{-1}_{Li}`."""
+    return -np.einsum("Jk...,Li...->iJkL...", Finv, Finv)
+
+
+def _identity4(F):
+    """:math:`\\delta_{ik}\\delta_{JL}`."""
+    d = F.shape[0]
+    eye = np.eye(d)
+    return np.einsum("ik,JL->iJkL", eye, eye).reshape((d,) * 4
+                                                      + (1,) * (F.ndim - 2))
+
+
+class Material:
+    """Base class: ``stress(F)``, ``tangent(F)``, ``energy(F)``."""
+
+    def stress(self, F):
+        raise NotImplementedError
+
+    def tangent(self, F):
+        raise NotImplementedError
+
+    def energy(self, F):
+        raise NotImplementedError
+
+    def __repr__(self):
+        args = ", ".join("{}={:.6g}".format(k, v) for k, v in vars(self)
+                         .items() if isinstance(v, (int, float)))
+        return "{}({})".format(type(self).__name__, args)
+
+
+class LinearElastic(Material):
+    r"""Small-strain linear elasticity as a function of ``F``:
+    :math:`\varepsilon = \mathrm{sym}(F - I)`,
+    :math:`P = \lambda\,\mathrm{tr}\varepsilon\, I + 2\mu\varepsilon`."""
+
+    def __init__(self, lam, mu, plane_stress=False):
+        if plane_stress:
+            lam = 2 * lam * mu / (lam + 2 * mu)
+        self.lam, self.mu = float(lam), float(mu)
+
+    def stress(self, F):
+        H = F - _eye(F)
+        eps = 0.5 * (H + np.swapaxes(H, 0, 1))
+        return self.lam * np.trace(eps) * _eye(F) + 2 * self.mu * eps
+
+    def tangent(self, F):
+        d = F.shape[0]
+        eye = np.eye(d)
+        A = (self.lam * np.einsum("iJ,kL->iJkL", eye, eye)
+             + self.mu * (np.einsum("ik,JL->iJkL", eye, eye)
+                          + np.einsum("iL,Jk->iJkL", eye, eye)))
+        return np.broadcast_to(A.reshape(A.shape + (1,) * (F.ndim - 2)),
+                               A.shape + F.shape[2:])
+
+    def energy(self, F):
+        H = F - _eye(F)
+        eps = 0.5 * (H + np.swapaxes(H, 0, 1))
+        return 0.5 * self.lam * np.trace(eps) ** 2 + self.mu * np.einsum(
+            "ij...,ij...->...", eps, eps)
+
+
+class StVenantKirchhoff(Material):
+    r"""St. Venant–Kirchhoff (2.45): :math:`S = \lambda\,\mathrm{tr}E\,I +
+    2\mu E`, :math:`P = FS`."""
+
+    def __init__(self, lam, mu):
+        self.lam, self.mu = float(lam), float(mu)
+
+    def _S(self, F):
+        E = 0.5 * (np.einsum("kI...,kJ...->IJ...", F, F) - _eye(F))
+        return self.lam * np.trace(E) * _eye(F) + 2 * self.mu * E, E
+
+    def stress(self, F):
+        S, _ = self._S(F)
+        return np.einsum("iK...,KJ...->iJ...", F, S)
+
+    def tangent(self, F):
+        S, _ = self._S(F)
+        d = F.shape[0]
+        eye = np.eye(d)
+        # delta_ik S_JL + F_iM C_MJNL F_kN
+        A = np.einsum("ik,JL...->iJkL...", eye, S)
+        A = A + self.lam * np.einsum("iJ...,kL...->iJkL...", F, F)
+        A = A + self.mu * (np.einsum("iN...,kN...,JL->iJkL...", F, F, eye)
+                           + np.einsum("iL...,kJ...->iJkL...", F, F))
+        return A
+
+    def energy(self, F):
+        _, E = self._S(F)
+        return 0.5 * self.lam * np.trace(E) ** 2 + self.mu * np.einsum(
+            "ij...,ij...->...", E, E)
+
+
+class NeoHooke(Material):
+    r"""Compressible neo-Hooke (2.42):
+    :math:`W = \frac\mu2(\mathrm{tr}C - 3 - 2\ln J)
+    + \frac\lambda4(J^2 - 1 - 2\ln J)`,
+    :math:`P = \mu(F - F^{-T}) + \frac\lambda2(J^2 - 1)F^{-T}`."""
+
+    def __init__(self, lam, mu):
+        self.lam, self.mu = float(lam), float(mu)
+
+    def stress(self, F):
+        Finv, J = _inv_det(F)
+        FinvT = np.swapaxes(Finv, 0, 1)
+        return self.mu * F + (0.5 * self.lam * (J ** 2 - 1) - self.mu) * FinvT
+
+    def tangent(self, F):
+        Finv, J = _inv_det(F)
+        FinvT = np.swapaxes(Finv, 0, 1)
+        c = 0.5 * self.lam * (J ** 2 - 1) - self.mu
+        return (self.mu * _identity4(F)
+                + self.lam * J ** 2 * _dyad(FinvT, FinvT)
+                + c * _inv_t_derivative(Finv))
+
+    def energy(self, F):
+        _, J = _inv_det(F)
+        d = F.shape[0]
+        trC = np.einsum("kI...,kI...->...", F, F) + (3 - d)
+        lnJ = np.log(J)
+        return (0.5 * self.mu * (trC - 3 - 2 * lnJ)
+                + 0.25 * self.lam * (J ** 2 - 1 - 2 * lnJ))
+
+
+class NeoHookeIsoVol(Material):
+    r"""Neo-Hooke with isochoric/volumetric split (2.43), (2.44):
+    :math:`W = \frac\mu2(\mathrm{tr}\,b_{iso} - 3)
+    + \frac K4(J^2 - 1 - 2\ln J)`, :math:`b_{iso} = J^{-2/3} b`,
+    :math:`K = \lambda + \frac23\mu`.  In 2-D: plane strain,
+    :math:`\mathrm{tr}\,b = \mathrm{tr}\,b_{2D} + 1`."""
+
+    def __init__(self, mu, K):
+        self.mu, self.K = float(mu), float(K)
+
+    @classmethod
+    def from_lame(cls, lam, mu):
+        return cls(mu, lam + 2.0 * mu / 3.0)
+
+    def stress(self, F):
+        Finv, J = _inv_det(F)
+        FinvT = np.swapaxes(Finv, 0, 1)
+        d = F.shape[0]
+        c = np.einsum("kI...,kI...->...", F, F) + (3 - d)  # tr C (3-D)
+        a = J ** (-2.0 / 3.0)
+        return (self.mu * a * (F - c / 3.0 * FinvT)
+                + 0.5 * self.K * (J ** 2 - 1) * FinvT)
+
+    def tangent(self, F):
+        Finv, J = _inv_det(F)
+        FinvT = np.swapaxes(Finv, 0, 1)
+        d = F.shape[0]
+        c = np.einsum("kI...,kI...->...", F, F) + (3 - d)
+        a = J ** (-2.0 / 3.0)
+        dFinvT = _inv_t_derivative(Finv)
+        iso = self.mu * a * (
+            -2.0 / 3.0 * _dyad(F - c / 3.0 * FinvT, FinvT)
+            + _identity4(F)
+            - 2.0 / 3.0 * _dyad(FinvT, F)
+            - c / 3.0 * dFinvT)
+        vol = (self.K * J ** 2 * _dyad(FinvT, FinvT)
+               + 0.5 * self.K * (J ** 2 - 1) * dFinvT)
+        return iso + vol
+
+    def energy(self, F):
+        _, J = _inv_det(F)
+        d = F.shape[0]
+        trb = np.einsum("kI...,kI...->...", F, F) + (3 - d)
+        return (0.5 * self.mu * (J ** (-2.0 / 3.0) * trb - 3)
+                + 0.25 * self.K * (J ** 2 - 1 - 2 * np.log(J)))

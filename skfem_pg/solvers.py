@@ -1,0 +1,221 @@
+r"""Newton's method with adaptive load stepping, and linear solvers.
+
+Works on FE bases (scikit-fem ``Basis`` with ``ElementVector``) and family
+bases alike: the same forms,
+
+.. math::
+
+    r(u)\cdot\delta u = \int P(F) : \nabla\delta u - \lambda f_{ext}, \qquad
+    K = \int \nabla\delta u : \mathbb A(F) : \nabla\Delta u,
+
+with :math:`F = I + \nabla u` from ``basis.interpolate(u)`` and the material
+law evaluated once per iteration (passed to the forms as ``w.P``, ``w.A``).
+
+Load stepping: the load factor :math:`\lambda` goes from 0 to 1 (external
+forces and prescribed displacements are scaled).  A step is cut in half when
+Newton diverges, exceeds ``maxiter`` or meets :math:`J \le 0` anywhere; a
+:class:`ConvergenceError` names the load factor once the step would fall
+below ``min_step``.
+"""
+import time
+
+import numpy as np
+import scipy.sparse.linalg as spl
+import skfem as fem
+from skfem.helpers import ddot, grad
+
+from .assembly import assemble
+
+
+class ConvergenceError(RuntimeError):
+    """Newton's method could not reach the requested load."""
+
+
+@fem.LinearForm
+def internal_force(v, w):
+    """:math:`\\int P : \\nabla v` with ``w.P`` the first Piola–Kirchhoff
+    stress at the quadrature points."""
+    return ddot(w.P, grad(v))
+
+
+@fem.BilinearForm
+def material_tangent(du, v, w):
+    """:math:`\\int \\nabla v : \\mathbb A : \\nabla du` with ``w.A`` the
+    consistent tangent."""
+    return np.einsum("iJkL...,kL...,iJ...->...", w.A, grad(du), grad(v))
+
+
+def rigid_body_modes(doflocs):
+    """Rigid-body modes of a vector field with interleaved dofs at
+    ``doflocs`` (``(d, N)``): ``d`` translations and ``d(d-1)/2``
+    rotations, as columns."""
+    d, N = doflocs.shape
+    x = doflocs[:, ::d]
+    n = x.shape[1]
+    modes = []
+    for a in range(d):
+        m = np.zeros((n, d))
+        m[:, a] = 1.0
+        modes.append(m)
+    for a in range(d):
+        for b in range(a + 1, d):
+            m = np.zeros((n, d))
+            m[:, a], m[:, b] = -x[b], x[a]
+            modes.append(m)
+    return np.column_stack([m.ravel() for m in modes])
+
+
+def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=60_000):
+    """A solver ``(A, b) -> x`` for ``fem.solve``.
+
+    ``"direct"``: SuperLU with a symmetric ordering (``MMD_AT_PLUS_A``);
+    ``"amg"``: CG preconditioned by pyamg smoothed aggregation with rigid
+    body modes (needs ``doflocs`` of the condensed system);
+    ``"auto"``: direct up to ``direct_limit`` unknowns, else AMG.
+    """
+    def solve(A, b, **kwargs):
+        k = kind
+        if k == "auto":
+            k = "direct" if A.shape[0] <= direct_limit or doflocs is None \
+                else "amg"
+        if k == "direct":
+            return spl.spsolve(A, b, permc_spec="MMD_AT_PLUS_A")
+        if k == "amg":
+            import pyamg
+            B = rigid_body_modes(doflocs) if doflocs is not None else None
+            ml = pyamg.smoothed_aggregation_solver(A.tocsr(), B=B,
+                                                   symmetry="hermitian")
+            res = []
+            x = ml.solve(b, tol=tol, accel="cg", maxiter=500, residuals=res)
+            if res[-1] > tol * max(res[0], 1e-300) * 10:
+                raise ConvergenceError("AMG-CG stopped at relative residual "
+                                       "{:.2e}".format(res[-1] / res[0]))
+            return x
+        raise ValueError("unknown linear solver {!r}".format(kind))
+    return solve
+
+
+def _as_dofs(D):
+    if D is None:
+        return np.zeros(0, dtype=np.int64)
+    if hasattr(D, "flatten"):
+        return np.asarray(D.flatten(), dtype=np.int64)
+    return np.asarray(D, dtype=np.int64).ravel()
+
+
+def _condensed_solver(kind, basis, I):
+    locs = getattr(basis, "doflocs", None)
+    return linear_solver(kind, None if locs is None else locs[:, I])
+
+
+def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
+           tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
+           verbose=True):
+    """Solve :math:`r(u) = 0` with adaptive load stepping.
+
+    Parameters
+    ----------
+    basis
+        Vector basis (``FamilyBasis`` or scikit-fem ``Basis``).
+    material
+        A :mod:`skfem_pg.materials` law.
+    f_ext
+        External force vector at load factor 1 (default 0).
+    D, u_D
+        Prescribed dofs and their values at load factor 1 (full-length
+        vector; default 0).
+    steps
+        Initial number of load steps (the step then adapts).
+    tol
+        Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
+        ``r_0`` is the first residual of the step.
+    solver
+        Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``.
+
+    Returns
+    -------
+    u, history
+        ``history`` is a list of dicts per converged step (load factor,
+        residual norms per iteration, minimum J, seconds).
+
+    """
+    N = basis.N
+    Dd = _as_dofs(D)
+    I = np.setdiff1d(np.arange(N), Dd)
+    f_ext = np.zeros(N) if f_ext is None else np.asarray(f_ext, float)
+    u_D = np.zeros(N) if u_D is None else np.asarray(u_D, float)
+    u = np.zeros(N) if u0 is None else np.array(u0, dtype=float)
+    lin = _condensed_solver(solver, basis, I)
+    d = basis.particles.dim if hasattr(basis, "particles") else \
+        basis.mesh.dim()
+    eye = np.eye(d).reshape(d, d, 1, 1)
+    lam, dlam = 0.0, 1.0 / steps
+    history = []
+    while lam < 1.0 - 1e-14:
+        target = min(1.0, lam + dlam)
+        t0 = time.perf_counter()
+        ok, uk, info = _newton_step(basis, material, u, target, f_ext, Dd,
+                                    u_D, I, lin, eye, tol, maxiter)
+        info.update(load=target, seconds=time.perf_counter() - t0)
+        if verbose:
+            print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
+                  "min J {:.3g}".format(
+                      target, target - lam,
+                      "converged" if ok else "FAILED ({})".format(
+                          info["reason"]),
+                      len(info["residuals"]) - 1,
+                      " ".join("{:.1e}".format(r)
+                               for r in info["residuals"]),
+                      info["min_J"]), flush=True)
+        if ok:
+            u, lam = uk, target
+            history.append(info)
+            if len(info["residuals"]) <= 5:
+                dlam = min(2 * dlam, 1.0)
+            continue
+        dlam /= 2
+        if dlam < min_step:
+            raise ConvergenceError(
+                "Newton failed at load factor {:.6g} ({}); the step fell "
+                "below min_step = {:.3g} after reaching load {:.6g}".format(
+                    target, info["reason"], min_step, lam))
+    return u, history
+
+
+def _newton_step(basis, material, u, lam, f_ext, Dd, u_D, I, lin, eye, tol,
+                 maxiter):
+    u = u.copy()
+    u[Dd] = lam * u_D[Dd]
+    res = []
+    info = {"residuals": res, "min_J": np.nan, "reason": ""}
+    ref = None
+    for it in range(maxiter + 1):
+        F = basis.interpolate(u).grad + eye
+        J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
+        info["min_J"] = float(J.min())
+        if not np.all(J > 0):
+            info["reason"] = "J <= 0"
+            return False, u, info
+        r = assemble(internal_force, basis, P=material.stress(F)) \
+            - lam * f_ext
+        rn = float(np.linalg.norm(r[I]))
+        res.append(rn)
+        if not np.isfinite(rn):
+            info["reason"] = "non-finite residual"
+            return False, u, info
+        if ref is None:
+            ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
+        if rn <= tol * ref:
+            return True, u, info
+        if it == maxiter:
+            info["reason"] = "maxiter"
+            return False, u, info
+        if it >= 3 and rn > res[-2] and res[-2] > res[-3]:
+            info["reason"] = "diverging"
+            return False, u, info
+        K = assemble(material_tangent, basis, A=material.tangent(F))
+        du = np.zeros_like(u)
+        du[I] = lin(K[I][:, I].tocsr(), -r[I])
+        u += du
+    info["reason"] = "maxiter"
+    return False, u, info

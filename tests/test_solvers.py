@@ -1,0 +1,91 @@
+"""Newton with adaptive load steps on PG and FE bases."""
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg import materials as mat
+from skfem_pg.models import linear_elasticity
+from skfem_pg.solvers import newton, linear_solver, ConvergenceError
+
+LAM, MU = 100.0, 40.0
+
+
+@pytest.fixture(scope="module")
+def beam():
+    mesh = pg.meshing.distort(fem.MeshQuad.init_tensor(
+        np.linspace(0, 4, 17), np.linspace(0, 1, 5)), 0.3, seed=1)
+    mesh = mesh.with_boundaries({"left": lambda x: np.isclose(x[0], 0),
+                                 "right": lambda x: np.isclose(x[0], 4)})
+    return mesh, pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+
+
+def test_small_load_matches_linear_solution(beam):
+    mesh, b = beam
+    f = pg.traction(b, "right", [0.0, 1e-4])
+    D = b.get_dofs("left")
+    u, hist = newton(b, mat.NeoHooke(LAM, MU), f, D=D, verbose=False)
+    ul = fem.solve(*fem.condense(pg.assemble(linear_elasticity(LAM, MU), b),
+                                 f, D=D))
+    assert np.abs(u - ul).max() <= 1e-4 * np.abs(ul).max()
+
+
+def test_newton_converges_quadratically(beam):
+    mesh, b = beam
+    f = pg.traction(b, "right", [0.0, 0.5])
+    u, hist = newton(b, mat.NeoHooke(LAM, MU), f, D=b.get_dofs("left"),
+                     tol=1e-12, verbose=False)
+    r = np.array(hist[-1]["residuals"])
+    r = r / r[0]
+    print("relative residuals:", r)
+    # pairs above the round-off floor (~1e-12 relative here)
+    late = np.nonzero((r[:-1] < 1e-1) & (r[1:] > 1e-10))[0]
+    assert len(late) >= 2
+    for k in late:
+        assert r[k + 1] <= 10 * r[k] ** 2
+
+
+def test_step_is_cut_when_J_becomes_negative(beam):
+    mesh, b = beam
+    f = pg.traction(b, "right", [0.0, 2.0])
+    u, hist = newton(b, mat.NeoHooke(LAM, MU), f, D=b.get_dofs("left"),
+                     steps=1, verbose=False)
+    assert len(hist) >= 2 and hist[-1]["load"] == 1.0
+    assert min(h["min_J"] for h in hist) > 0
+
+
+def test_impossible_compression_reports_the_load_factor(beam):
+    mesh, b = beam
+    D = b.get_dofs({"left", "right"})
+    u_D = np.zeros(b.N)
+    right = b.get_dofs("right").nodal["u^1"]
+    u_D[right] = -5.0  # squeeze a bar of length 4 by 5
+    with pytest.raises(ConvergenceError, match="load factor"):
+        newton(b, mat.NeoHooke(LAM, MU), D=D, u_D=u_D, steps=2,
+               min_step=1 / 16, verbose=False)
+
+
+def test_same_newton_on_scikit_fem_q1(beam):
+    mesh, _ = beam
+    fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+    fb = fem.FacetBasis(mesh, fem.ElementVector(fem.ElementQuad1()),
+                        facets="right")
+    f = fem.LinearForm(lambda v, w: 1e-4 * v[1]).assemble(fb)
+    D = fe.get_dofs("left")
+    u, _ = newton(fe, mat.NeoHooke(LAM, MU), f, D=D, verbose=False)
+    ul = fem.solve(*fem.condense(linear_elasticity(LAM, MU).assemble(fe), f,
+                                 D=D))
+    assert np.abs(u - ul).max() <= 1e-4 * np.abs(ul).max()
+
+
+def test_amg_with_rigid_body_modes_matches_direct():
+    mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 41)] * 2)
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    K = pg.assemble(linear_elasticity(LAM, MU), b)
+    f = pg.body_force(b, [0.0, -1.0])
+    D = b.get_dofs(lambda x: np.isclose(x[0], 0))
+    I = b.complement_dofs(D)
+    A, rhs = K[I][:, I].tocsr(), f[I]
+    x_direct = linear_solver("direct")(A, rhs)
+    x_amg = linear_solver("amg", b.doflocs[:, I], tol=1e-12)(A, rhs)
+    assert np.abs(x_amg - x_direct).max() <= 1e-8 * np.abs(x_direct).max()
