@@ -157,9 +157,8 @@ def _assemble_bilinear(form, basis, kwargs):
     sel = [a * nch + b for a in range(nc) for b in ch]
     C = C[..., sel, :][..., :, sel]
     nb = len(ch)
-    indptr, indices, pieces = block_pattern(basis)
-    data = np.zeros((len(indices), nc, nc))
-    for sl, u, inv in pieces:
+
+    def local_matrices(sl):
         Gh = _extended_gradients(basis, sl, ch)  # (k, j, i, β)
         X = Gh * basis.dx[sl][:, :, None, None]
         nfc = X.shape[0]
@@ -175,7 +174,24 @@ def _assemble_bilinear(form, basis, kwargs):
         Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, m * nb, m)
         K = np.matmul(Tm, Gm).reshape(nfc, m, nc, nc, m)
         # block (row l, col i) holds K[(l, c), (i, a)] as [c, a]
-        K = K.transpose(0, 4, 1, 3, 2).reshape(nfc * m * m, nc * nc)
+        return K.transpose(0, 4, 1, 3, 2)
+
+    return assemble_local(basis, local_matrices)
+
+
+def assemble_local(basis, local_matrices):
+    """Sparse matrix from local family matrices.
+
+    ``local_matrices(sl)`` returns, for the families ``sl``, an array of
+    shape ``(nfc, m, m, c, c)``: block ``[k, l, i]`` couples row member
+    ``l`` (test) with column member ``i`` (trial), components ``[c_l, c_i]``.
+    Blocks are summed into the cached :func:`block_pattern`.
+    """
+    nc = 1 if basis.ncomp is None else basis.ncomp
+    indptr, indices, pieces = block_pattern(basis)
+    data = np.zeros((len(indices), nc, nc))
+    for sl, u, inv in pieces:
+        K = local_matrices(sl).reshape(-1, nc * nc)
         acc = np.stack([np.bincount(inv, weights=K[:, q], minlength=len(u))
                         for q in range(nc * nc)], axis=-1)
         data[u] += acc.reshape(len(u), nc, nc)

@@ -25,6 +25,7 @@ import skfem as fem
 from skfem.helpers import ddot, grad
 
 from .assembly import assemble
+from .tangents import fd_tangent
 
 
 class ConvergenceError(RuntimeError):
@@ -110,7 +111,7 @@ def _condensed_solver(kind, basis, I):
 
 def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           verbose=True):
+           tangent="consistent", verbose=True):
     """Solve :math:`r(u) = 0` with adaptive load stepping.
 
     Parameters
@@ -131,6 +132,10 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         ``r_0`` is the first residual of the step.
     solver
         Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``.
+    tangent
+        ``"consistent"`` (the material tangent) or ``"fd"`` (central
+        differences of the family forces, family bases only; see
+        :mod:`skfem_pg.tangents`).
 
     Returns
     -------
@@ -139,6 +144,11 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         residual norms per iteration, minimum J, seconds).
 
     """
+    if tangent not in ("consistent", "fd"):
+        raise ValueError("tangent must be 'consistent' or 'fd'")
+    if tangent == "fd" and not hasattr(basis, "G"):
+        raise ValueError("the finite-difference tangent is built from "
+                         "family forces: it needs a FamilyBasis")
     N = basis.N
     Dd = _as_dofs(D)
     I = np.setdiff1d(np.arange(N), Dd)
@@ -155,7 +165,7 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
         ok, uk, info = _newton_step(basis, material, u, target, f_ext, Dd,
-                                    u_D, I, lin, eye, tol, maxiter)
+                                    u_D, I, lin, eye, tol, maxiter, tangent)
         info.update(load=target, seconds=time.perf_counter() - t0)
         if verbose:
             print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
@@ -183,7 +193,7 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
 
 
 def _newton_step(basis, material, u, lam, f_ext, Dd, u_D, I, lin, eye, tol,
-                 maxiter):
+                 maxiter, tangent):
     u = u.copy()
     u[Dd] = lam * u_D[Dd]
     res = []
@@ -213,7 +223,10 @@ def _newton_step(basis, material, u, lam, f_ext, Dd, u_D, I, lin, eye, tol,
         if it >= 3 and rn > res[-2] and res[-2] > res[-3]:
             info["reason"] = "diverging"
             return False, u, info
-        K = assemble(material_tangent, basis, A=material.tangent(F))
+        if tangent == "fd":
+            K = fd_tangent(basis, material, F)
+        else:
+            K = assemble(material_tangent, basis, A=material.tangent(F))
         du = np.zeros_like(u)
         du[I] = lin(K[I][:, I].tocsr(), -r[I])
         u += du

@@ -89,3 +89,22 @@ def test_amg_with_rigid_body_modes_matches_direct():
     x_direct = linear_solver("direct")(A, rhs)
     x_amg = linear_solver("amg", b.doflocs[:, I], tol=1e-12)(A, rhs)
     assert np.abs(x_amg - x_direct).max() <= 1e-8 * np.abs(x_direct).max()
+
+
+def test_fd_tangent_matches_consistent_tangent(beam):
+    from skfem_pg.solvers import material_tangent
+    from skfem_pg.tangents import fd_tangent
+    mesh, b = beam
+    rng = np.random.default_rng(2)
+    u = 0.02 * rng.standard_normal(b.N)
+    F = b.interpolate(u).grad + np.eye(2)[:, :, None, None]
+    m = mat.NeoHooke(LAM, MU)
+    K = pg.assemble(material_tangent, b, A=m.tangent(F))
+    Kfd = fd_tangent(b, m, F)
+    assert abs(K - Kfd).max() <= 1e-6 * abs(K).max()
+    # and Newton with it converges to the same solution
+    f = pg.traction(b, "right", [0.0, 0.5])
+    D = b.get_dofs("left")
+    u1, _ = newton(b, m, f, D=D, verbose=False)
+    u2, _ = newton(b, m, f, D=D, tangent="fd", verbose=False)
+    assert np.abs(u1 - u2).max() <= 1e-8 * np.abs(u1).max()
