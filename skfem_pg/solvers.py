@@ -1,15 +1,9 @@
 r"""Newton's method with adaptive load stepping, and linear solvers.
 
-Works on FE bases (scikit-fem ``Basis`` with ``ElementVector``) and family
-bases alike: the same forms,
-
-.. math::
-
-    r(u)\cdot\delta u = \int P(F) : \nabla\delta u - \lambda f_{ext}, \qquad
-    K = \int \nabla\delta u : \mathbb A(F) : \nabla\Delta u,
-
-with :math:`F = I + \nabla u` from ``basis.interpolate(u)`` and the material
-law evaluated once per iteration (passed to the forms as ``w.P``, ``w.A``).
+Newton drives a model of :mod:`skfem_pg.mechanics` (``Hyperelastic`` on FE
+or family bases, ``MeanDilatation`` for Q1P0/H1P0): residual
+:math:`r(u) = f_{int}(u) - \lambda f_{ext}`, tangent
+:math:`\partial f_{int}/\partial u`.
 
 Load stepping: the load factor :math:`\lambda` goes from 0 to 1 (external
 forces and prescribed displacements are scaled).  A step is cut in half when
@@ -21,29 +15,10 @@ import time
 
 import numpy as np
 import scipy.sparse.linalg as spl
-import skfem as fem
-from skfem.helpers import ddot, grad
-
-from .assembly import assemble
-from .tangents import fd_tangent
 
 
 class ConvergenceError(RuntimeError):
     """Newton's method could not reach the requested load."""
-
-
-@fem.LinearForm
-def internal_force(v, w):
-    """:math:`\\int P : \\nabla v` with ``w.P`` the first Piola–Kirchhoff
-    stress at the quadrature points."""
-    return ddot(w.P, grad(v))
-
-
-@fem.BilinearForm
-def material_tangent(du, v, w):
-    """:math:`\\int \\nabla v : \\mathbb A : \\nabla du` with ``w.A`` the
-    consistent tangent."""
-    return np.einsum("iJkL...,kL...,iJ...->...", w.A, grad(du), grad(v))
 
 
 def rigid_body_modes(doflocs):
@@ -109,17 +84,17 @@ def _condensed_solver(kind, basis, I):
     return linear_solver(kind, None if locs is None else locs[:, I])
 
 
-def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
+def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           tangent="consistent", verbose=True):
-    """Solve :math:`r(u) = 0` with adaptive load stepping.
+           verbose=True):
+    r"""Solve :math:`f_{int}(u) = \lambda f_{ext}` up to :math:`\lambda = 1`
+    with adaptive load steps.
 
     Parameters
     ----------
-    basis
-        Vector basis (``FamilyBasis`` or scikit-fem ``Basis``).
-    material
-        A :mod:`skfem_pg.materials` law.
+    model
+        A :mod:`skfem_pg.mechanics` model, e.g.
+        ``Hyperelastic(basis, NeoHooke(lam, mu))``.
     f_ext
         External force vector at load factor 1 (default 0).
     D, u_D
@@ -129,13 +104,11 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         Initial number of load steps (the step then adapts).
     tol
         Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
-        ``r_0`` is the first residual of the step.
+        ``r_0`` is the first residual of the step, or a Newton increment
+        below ``1e-10 |u|`` (the round-off floor of ill-conditioned, e.g.
+        nearly incompressible, problems).
     solver
         Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``.
-    tangent
-        ``"consistent"`` (the material tangent) or ``"fd"`` (central
-        differences of the family forces, family bases only; see
-        :mod:`skfem_pg.tangents`).
 
     Returns
     -------
@@ -144,11 +117,7 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         residual norms per iteration, minimum J, seconds).
 
     """
-    if tangent not in ("consistent", "fd"):
-        raise ValueError("tangent must be 'consistent' or 'fd'")
-    if tangent == "fd" and not hasattr(basis, "G"):
-        raise ValueError("the finite-difference tangent is built from "
-                         "family forces: it needs a FamilyBasis")
+    basis = model.basis
     N = basis.N
     Dd = _as_dofs(D)
     I = np.setdiff1d(np.arange(N), Dd)
@@ -156,16 +125,13 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     u_D = np.zeros(N) if u_D is None else np.asarray(u_D, float)
     u = np.zeros(N) if u0 is None else np.array(u0, dtype=float)
     lin = _condensed_solver(solver, basis, I)
-    d = basis.particles.dim if hasattr(basis, "particles") else \
-        basis.mesh.dim()
-    eye = np.eye(d).reshape(d, d, 1, 1)
     lam, dlam = 0.0, 1.0 / steps
     history = []
     while lam < 1.0 - 1e-14:
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
-        ok, uk, info = _newton_step(basis, material, u, target, f_ext, Dd,
-                                    u_D, I, lin, eye, tol, maxiter, tangent)
+        ok, uk, info = _newton_step(model, u, target, f_ext, Dd, u_D, I, lin,
+                                    tol, maxiter)
         info.update(load=target, seconds=time.perf_counter() - t0)
         if verbose:
             print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
@@ -192,22 +158,20 @@ def newton(basis, material, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     return u, history
 
 
-def _newton_step(basis, material, u, lam, f_ext, Dd, u_D, I, lin, eye, tol,
-                 maxiter, tangent):
+def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
     u = u.copy()
     u[Dd] = lam * u_D[Dd]
     res = []
     info = {"residuals": res, "min_J": np.nan, "reason": ""}
     ref = None
+    du_norm = np.inf
     for it in range(maxiter + 1):
-        F = basis.interpolate(u).grad + eye
-        J = np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
-        info["min_J"] = float(J.min())
-        if not np.all(J > 0):
+        state = model.state(u)
+        info["min_J"] = model.min_J(state)
+        if not info["min_J"] > 0:
             info["reason"] = "J <= 0"
             return False, u, info
-        r = assemble(internal_force, basis, P=material.stress(F)) \
-            - lam * f_ext
+        r = model.internal_force(state) - lam * f_ext
         rn = float(np.linalg.norm(r[I]))
         res.append(rn)
         if not np.isfinite(rn):
@@ -215,20 +179,18 @@ def _newton_step(basis, material, u, lam, f_ext, Dd, u_D, I, lin, eye, tol,
             return False, u, info
         if ref is None:
             ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
-        if rn <= tol * ref:
+        if rn <= tol * ref or du_norm <= 1e-10 * np.abs(u).max():
             return True, u, info
         if it == maxiter:
             info["reason"] = "maxiter"
             return False, u, info
-        if it >= 3 and rn > res[-2] and res[-2] > res[-3]:
+        if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
             info["reason"] = "diverging"
             return False, u, info
-        if tangent == "fd":
-            K = fd_tangent(basis, material, F)
-        else:
-            K = assemble(material_tangent, basis, A=material.tangent(F))
+        K = model.tangent(state)
         du = np.zeros_like(u)
         du[I] = lin(K[I][:, I].tocsr(), -r[I])
+        du_norm = np.abs(du).max()
         u += du
     info["reason"] = "maxiter"
     return False, u, info
