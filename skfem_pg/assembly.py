@@ -1,8 +1,8 @@
-r"""Batched assembly of scikit-fem forms on a :class:`FamilyBasis`.
+r"""Batched assembly of scikit-fem forms on family bases and FE cell bases.
 
 scikit-fem's generic assembly calls the form once per pair of local basis
 functions: ``(c·m)²`` calls (324 for a 2-D quad family, 6561 for a 3-D hex
-family), each over all families.  A bilinear form is linear in the value and
+family), each over all elements.  A bilinear form is linear in the value and
 gradient of ``u`` and of ``v``, so it is fully described by its coefficients
 
 .. math::
@@ -18,27 +18,110 @@ scalars).  The local matrices
 
     K^k_{(l c),(i a)} = \sum_j w_{kj} \sum_{\beta\gamma}
         C_{(a\beta)(c\gamma)}^{kj}\, \hat G^{kji}_\beta \hat G^{kjl}_\gamma,
-    \qquad \hat G^{kji} = (\delta_{ij}, G^{kji}),
+    \qquad \hat G^{kji} = (N^{kji}, G^{kji}),
 
-are then batched matrix products over families, scattered into a block
-sparsity pattern computed once per basis.  Forms that use more than values
-and gradients (``hess``...) raise; use ``form.assemble(basis)`` for those.
+are batched matrix products, scattered into a block sparsity pattern that is
+computed once per basis.  For a family basis ``k`` is a family, ``j`` a
+member (quadrature point) and ``i`` a member (basis function) with
+:math:`N^{kji} = \delta_{ij}`; for a scikit-fem cell basis ``k`` is an
+element, ``j`` a quadrature point and ``i`` a scalar shape function — the
+same code assembles FE comparators.  Forms that use more than values and
+gradients (``hess`` ...) raise; use ``form.assemble(basis)`` for those.
 """
 import numpy as np
 import scipy.sparse as sp
+import skfem as fem
 from skfem.assembly import BilinearForm, LinearForm
 from skfem.assembly.form.form import FormExtraParams
-from skfem.element import DiscreteField
+from skfem.element import DiscreteField, ElementVector
 
 from .basis import FamilyBasis
 from .shape.common import chunks
 
 
-def _probes(basis):
+class _FamilyView:
+    """Local arrays of a :class:`FamilyBasis`."""
+
+    def __init__(self, basis):
+        self.basis = basis
+        self.conn, self.mask = basis.families.padded()
+        self.nq = self.nloc = self.conn.shape[1]
+        self.dim = basis.particles.dim
+        self.scalar = basis.ncomp is None
+        self.nc = 1 if self.scalar else basis.ncomp
+        self.n_nodes = basis.particles.n
+        self.dx = basis.dx
+
+    def ext_grad(self, sl, channels):
+        """``Ĝ[k, j, i, β]`` for families ``sl``; β over ``channels``."""
+        G = self.basis.G[sl]
+        nfc, m = G.shape[:2]
+        parts = []
+        for beta in channels:
+            if beta == 0:
+                parts.append(np.broadcast_to(
+                    np.eye(m) * self.mask[sl][:, None, :], (nfc, m, m)))
+            else:
+                parts.append(G[..., beta - 1])
+        return np.stack(parts, axis=-1)
+
+
+class _CellView:
+    """Local arrays of a scikit-fem ``CellBasis`` (scalar element or
+    ``ElementVector`` of one): elements, quadrature points and the scalar
+    shape functions, whose dof ``s`` carries vector dofs ``c·s + a``."""
+
+    def __init__(self, basis):
+        elem = basis.elem
+        vector = isinstance(elem, ElementVector)
+        self.basis = basis
+        self.scalar = not vector
+        self.nc = elem.dim if vector else 1
+        sb = getattr(basis, "_pg_scalar_basis", None)
+        if sb is None:
+            sb = basis if not vector else fem.Basis(
+                basis.mesh, elem.elem, mapping=basis.mapping,
+                quadrature=basis.quadrature, elements=basis.tind)
+            basis._pg_scalar_basis = sb
+        self.sb = sb
+        self.conn = sb.element_dofs.T
+        self.mask = np.ones(self.conn.shape, dtype=bool)
+        self.nloc = self.conn.shape[1]
+        self.nq = basis.dx.shape[1]
+        self.dim = basis.mesh.dim()
+        self.n_nodes = sb.N
+        self.dx = basis.dx
+        expected = (self.nc * self.conn[:, :, None]
+                    + np.arange(self.nc)).reshape(len(self.conn), -1).T
+        if vector and not np.array_equal(expected, basis.element_dofs):
+            raise NotImplementedError("unexpected vector dof numbering")
+
+    def ext_grad(self, sl, channels):
+        parts = []
+        for beta in channels:
+            if beta == 0:
+                v = [np.asarray(self.sb.basis[i][0])[sl]
+                     for i in range(self.nloc)]
+            else:
+                v = [self.sb.basis[i][0].grad[beta - 1][sl]
+                     for i in range(self.nloc)]
+            parts.append(np.stack(v, axis=-1))  # (k, q, i)
+        return np.stack(parts, axis=-1)
+
+
+def _view(basis):
+    if isinstance(basis, FamilyBasis):
+        return _FamilyView(basis)
+    if isinstance(basis, fem.CellBasis) and not isinstance(
+            basis.elem, fem.ElementComposite):
+        return _CellView(basis)
+    return None
+
+
+def _probes(view):
     """Unit probe fields: list of ``(component, channel, DiscreteField)``;
     channel 0 is the value, channel ``1 + b`` the derivative ``∂_b``."""
-    d = basis.particles.dim
-    nc = 1 if basis.ncomp is None else basis.ncomp
+    d, nc = view.dim, view.nc
     out = []
     for a in range(nc):
         for beta in range(d + 1):
@@ -48,25 +131,10 @@ def _probes(basis):
                 val[a] = 1.0
             else:
                 grad[a, beta - 1] = 1.0
-            if basis.ncomp is None:
+            if view.scalar:
                 val, grad = val[0], grad[0]
             out.append((a, beta, DiscreteField(val, grad)))
     return out
-
-
-def _extended_gradients(basis, sl, channels):
-    """``Ĝ[k, j, i, β]`` for families ``sl``; β over ``channels``."""
-    mem, mask = basis.families.padded()
-    G = basis.G[sl]
-    nfc, m = G.shape[:2]
-    parts = []
-    for beta in channels:
-        if beta == 0:
-            parts.append(np.broadcast_to(np.eye(m) * mask[sl][:, None, :],
-                                         (nfc, m, m)))
-        else:
-            parts.append(G[..., beta - 1])
-    return np.stack(parts, axis=-1)
 
 
 def _coefficients(values, shape):
@@ -82,28 +150,23 @@ def _coefficients(values, shape):
     return out, False
 
 
-def _used_channels(C, nc, nch, axis_is_pair=True):
+def _used_channels(C, nc, nch):
     """Channels (value/derivatives) with a non-zero coefficient."""
     used = []
     for beta in range(nch):
         idx = [a * nch + beta for a in range(nc)]
-        if axis_is_pair:
-            sub = np.concatenate([np.take(C, idx, axis=-2).ravel(),
-                                  np.take(C, idx, axis=-1).ravel()])
-        else:
-            sub = np.take(C, idx, axis=-1).ravel()
+        sub = np.concatenate([np.take(C, idx, axis=-2).ravel(),
+                              np.take(C, idx, axis=-1).ravel()])
         if np.any(sub != 0):
             used.append(beta)
     return used or [1]
 
 
-def _setup(form, basis, kwargs):
-    """``w``, probes and sizes shared by the bilinear and linear paths."""
+def _setup(form, basis, view, kwargs):
+    """``w`` and probes shared by the bilinear and linear paths."""
     w = FormExtraParams({**basis.default_parameters(),
                          **form._normalize_asm_kwargs(kwargs, basis)})
-    nf, m = basis.families.padded()[0].shape
-    nc = 1 if basis.ncomp is None else basis.ncomp
-    return w, _probes(basis), nf, m, nc, basis.particles.dim + 1
+    return w, _probes(view)
 
 
 def _call(form, *args):
@@ -117,29 +180,29 @@ def _call(form, *args):
             from err
 
 
-def block_pattern(basis):
-    """Node-level sparsity pattern of the basis, computed once and cached:
-    CSR ``indptr`` and ``indices``, and for each chunk of families the
-    distinct block indices ``u`` it touches and, per local pair
-    ``(row member l, column member i)``, its index ``inv`` into ``u``."""
-    if basis._pattern is None:
-        mem, mask = basis.families.padded()
-        nf, m = mem.shape
-        n = basis.particles.n
-        nc = 1 if basis.ncomp is None else basis.ncomp
+def block_pattern(basis, view=None):
+    """Node-level sparsity pattern of the basis, computed once and cached
+    on it: CSR ``indptr`` and ``indices``, and for each chunk of elements
+    the distinct block indices ``u`` it touches and, per local pair
+    ``(row node l, column node i)``, its index ``inv`` into ``u``."""
+    if getattr(basis, "_pattern", None) is None:
+        view = _view(basis) if view is None else view
+        conn, mask = view.conn, view.mask
+        ne, m = conn.shape
+        n = view.n_nodes
         E = sp.csr_matrix((np.ones(mask.sum()),
-                           (np.broadcast_to(np.arange(nf)[:, None],
-                                            mem.shape)[mask], mem[mask])),
-                          shape=(nf, n))
+                           (np.broadcast_to(np.arange(ne)[:, None],
+                                            conn.shape)[mask], conn[mask])),
+                          shape=(ne, n))
         S = (E.T @ E).tocsr()
         S.sort_indices()
         rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(S.indptr))
         keys = rows * n + S.indices
         pieces = []
-        for sl in chunks(nf, m * m * nc * nc * (basis.particles.dim + 1),
+        for sl in chunks(ne, view.nq * m * view.nc ** 2 * (view.dim + 1),
                          budget=2 ** 24):
-            loc = (mem[sl, :, None].astype(np.int64) * n
-                   + mem[sl, None, :]).ravel()
+            loc = (conn[sl, :, None].astype(np.int64) * n
+                   + conn[sl, None, :]).ravel()
             u, inv = np.unique(np.searchsorted(keys, loc),
                                return_inverse=True)
             pieces.append((sl, u, inv.astype(np.int64)))
@@ -147,48 +210,52 @@ def block_pattern(basis):
     return basis._pattern
 
 
-def _assemble_bilinear(form, basis, kwargs):
-    w, probes, nf, m, nc, nch = _setup(form, basis, kwargs)
+def _assemble_bilinear(form, basis, view, kwargs):
+    w, probes = _setup(form, basis, view, kwargs)
+    ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
+    nch = view.dim + 1
     # C[p, q]: p = trial probe (a, β), q = test probe (c, γ)
     values = [[_call(form, pu, pv, w) for (_, _, pv) in probes]
               for (_, _, pu) in probes]
-    C, const = _coefficients(values, (nf, m))
+    C, const = _coefficients(values, (ne, nq))
     ch = _used_channels(C, nc, nch)
     sel = [a * nch + b for a in range(nc) for b in ch]
     C = C[..., sel, :][..., :, sel]
     nb = len(ch)
 
     def local_matrices(sl):
-        Gh = _extended_gradients(basis, sl, ch)  # (k, j, i, β)
-        X = Gh * basis.dx[sl][:, :, None, None]
+        Gh = view.ext_grad(sl, ch)  # (k, j, i, β)
+        X = Gh * view.dx[sl][:, :, None, None]
         nfc = X.shape[0]
         if const:
             # T[k, j, i, a, c, γ] = sum_β X[k, j, i, β] C[a, β, c, γ]
             T = np.tensordot(X, C.reshape(nc, nb, nc, nb), axes=([3], [1]))
         else:
-            Ck = C[sl].reshape((nfc, m, nc, nb, nc, nb))
-            Ck = Ck.transpose(0, 1, 3, 2, 4, 5).reshape(nfc, m, nb, -1)
-            T = np.matmul(X, Ck).reshape(nfc, m, m, nc, nc, nb)
+            Ck = C[sl].reshape((nfc, nq, nc, nb, nc, nb))
+            Ck = Ck.transpose(0, 1, 3, 2, 4, 5).reshape(nfc, nq, nb, -1)
+            T = np.matmul(X, Ck).reshape(nfc, nq, m, nc, nc, nb)
         # K[k, i, a, c, l] = sum_{j, γ} T[k, j, i, a, c, γ] Ĝ[k, j, l, γ]
-        Tm = T.transpose(0, 2, 3, 4, 1, 5).reshape(nfc, m * nc * nc, m * nb)
-        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, m * nb, m)
+        Tm = T.transpose(0, 2, 3, 4, 1, 5).reshape(nfc, m * nc * nc,
+                                                   nq * nb)
+        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nb, m)
         K = np.matmul(Tm, Gm).reshape(nfc, m, nc, nc, m)
         # block (row l, col i) holds K[(l, c), (i, a)] as [c, a]
         return K.transpose(0, 4, 1, 3, 2)
 
-    return assemble_local(basis, local_matrices)
+    return assemble_local(basis, local_matrices, view)
 
 
-def assemble_local(basis, local_matrices):
-    """Sparse matrix from local family matrices.
+def assemble_local(basis, local_matrices, view=None):
+    """Sparse matrix from local element/family matrices.
 
-    ``local_matrices(sl)`` returns, for the families ``sl``, an array of
-    shape ``(nfc, m, m, c, c)``: block ``[k, l, i]`` couples row member
-    ``l`` (test) with column member ``i`` (trial), components ``[c_l, c_i]``.
+    ``local_matrices(sl)`` returns, for the elements ``sl``, an array of
+    shape ``(ne, m, m, c, c)``: block ``[k, l, i]`` couples row node ``l``
+    (test) with column node ``i`` (trial), components ``[c_l, c_i]``.
     Blocks are summed into the cached :func:`block_pattern`.
     """
-    nc = 1 if basis.ncomp is None else basis.ncomp
-    indptr, indices, pieces = block_pattern(basis)
+    view = _view(basis) if view is None else view
+    nc = view.nc
+    indptr, indices, pieces = block_pattern(basis, view)
     data = np.zeros((len(indices), nc, nc))
     for sl, u, inv in pieces:
         K = local_matrices(sl).reshape(-1, nc * nc)
@@ -201,44 +268,45 @@ def assemble_local(basis, local_matrices):
     return sp.bsr_matrix((data, indices, indptr), shape=(N, N)).tocsr()
 
 
-def _assemble_linear(form, basis, kwargs):
-    w, probes, nf, m, nc, nch = _setup(form, basis, kwargs)
-    mem = basis.families.padded()[0]
+def _assemble_linear(form, basis, view, kwargs):
+    w, probes = _setup(form, basis, view, kwargs)
+    ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
+    nch = view.dim + 1
     values = [[_call(form, pv, w) for (_, _, pv) in probes]]
-    C, const = _coefficients(values, (nf, m))
-    C = C[..., 0, :]  # (P,) or (nf, m, P)
+    C, const = _coefficients(values, (ne, nq))
+    C = C[..., 0, :]  # (P,) or (ne, nq, P)
     b = np.zeros(basis.N)
-    for sl in chunks(nf, m * m * nc * nch, budget=2 ** 24):
-        Gh = _extended_gradients(basis, sl, range(nch))
-        dx = basis.dx[sl]
+    for sl in chunks(ne, nq * m * nc * nch, budget=2 ** 24):
+        Gh = view.ext_grad(sl, range(nch))
+        dx = view.dx[sl]
         Cs = C if const else C[sl]
         Cs = np.broadcast_to(Cs, dx.shape + (nc * nch,)) \
             .reshape(dx.shape + (nc, nch))
         # f[k, l, c] = sum_j dx sum_γ C[k, j, c, γ] Ĝ[k, j, l, γ]
         nfc = dx.shape[0]
         X = (dx[..., None, None] * Cs).transpose(0, 2, 1, 3) \
-            .reshape(nfc, nc, m * nch)
-        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, m * nch, m)
+            .reshape(nfc, nc, nq * nch)
+        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nch, m)
         f = np.swapaxes(X @ Gm, -1, -2)
-        dofs = nc * mem[sl][:, :, None] + np.arange(nc)
+        dofs = nc * view.conn[sl][:, :, None] + np.arange(nc)
         b += np.bincount(dofs.ravel(), weights=f.ravel(), minlength=basis.N)
     return b
 
 
 def assemble(form, basis, vbasis=None, **kwargs):
-    """Assemble ``form`` on ``basis`` — the fast path for family bases.
+    """Assemble ``form`` on ``basis`` with batched local matrices.
 
-    For a :class:`FamilyBasis` (and no different test basis), bilinear and
-    linear forms are assembled with batched local matrices; anything else
+    Works for :class:`FamilyBasis` and scikit-fem cell bases (scalar or
+    ``ElementVector``) when no different test basis is given; anything else
     is passed on to ``form.assemble``.  The result equals
-    ``form.assemble(basis, **kwargs)`` (see ``tests/test_assembly.py``).
+    ``form.assemble(basis, **kwargs)`` (``tests/test_assembly.py``).
     """
-    if isinstance(basis, FamilyBasis) and (vbasis is None or
-                                           vbasis is basis):
+    view = _view(basis) if (vbasis is None or vbasis is basis) else None
+    if view is not None:
         if isinstance(form, BilinearForm):
-            return _assemble_bilinear(form, basis, kwargs)
+            return _assemble_bilinear(form, basis, view, kwargs)
         if isinstance(form, LinearForm):
-            return _assemble_linear(form, basis, kwargs)
+            return _assemble_linear(form, basis, view, kwargs)
     if vbasis is None:
         return form.assemble(basis, **kwargs)
     return form.assemble(basis, vbasis, **kwargs)

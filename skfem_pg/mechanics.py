@@ -46,7 +46,8 @@ def internal_force(v, w):
 def material_tangent(du, v, w):
     """:math:`\\int \\nabla v : \\mathbb A : \\nabla du` with ``w.A`` the
     consistent tangent."""
-    return np.einsum("iJkL...,kL...,iJ...->...", w.A, grad(du), grad(v))
+    Adu = (w.A * grad(du)[None, None]).sum(axis=(2, 3))  # A : grad(du)
+    return ddot(Adu, grad(v))
 
 
 def _dim(basis):
@@ -136,7 +137,7 @@ class MeanDilatation(Hyperelastic):
         dJFinvT = J * (FinvT[:, :, None, None] * FinvT[None, None]
                        - np.einsum("Jk...,Li...->iJkL...", Finv, Finv))
         A = self.material.tangent(F) + p * dJFinvT
-        K = material_tangent.assemble(self.basis, A=A)
+        K = assemble(material_tangent, self.basis, A=A)
         # rank-one volumetric term per element
         g = internal_force.elemental(self.basis, P=J * FinvT).tolocal()
         Upp = 0.5 * self.K * (1.0 + 1.0 / Theta ** 2)

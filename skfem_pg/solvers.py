@@ -162,16 +162,19 @@ def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
     u = u.copy()
     u[Dd] = lam * u_D[Dd]
     res = []
-    info = {"residuals": res, "min_J": np.nan, "reason": ""}
+    info = {"residuals": res, "min_J": np.nan, "reason": "",
+            "t_assemble": 0.0, "t_linear": 0.0}
     ref = None
     du_norm = np.inf
     for it in range(maxiter + 1):
+        t0 = time.perf_counter()
         state = model.state(u)
         info["min_J"] = model.min_J(state)
         if not info["min_J"] > 0:
             info["reason"] = "J <= 0"
             return False, u, info
         r = model.internal_force(state) - lam * f_ext
+        info["t_assemble"] += time.perf_counter() - t0
         rn = float(np.linalg.norm(r[I]))
         res.append(rn)
         if not np.isfinite(rn):
@@ -187,9 +190,13 @@ def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
         if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
             info["reason"] = "diverging"
             return False, u, info
+        t0 = time.perf_counter()
         K = model.tangent(state)
+        t1 = time.perf_counter()
         du = np.zeros_like(u)
         du[I] = lin(K[I][:, I].tocsr(), -r[I])
+        info["t_assemble"] += t1 - t0
+        info["t_linear"] += time.perf_counter() - t1
         du_norm = np.abs(du).max()
         u += du
     info["reason"] = "maxiter"

@@ -82,3 +82,37 @@ def test_forms_needing_hessians_are_refused_by_fast_path():
 
     with pytest.raises(TypeError, match="form.assemble"):
         pg.assemble(biharmonic, b)
+
+
+@pytest.mark.parametrize("mesh_elem", [
+    (square(4, 0.3), fem.ElementQuad1()),
+    (square(4, 0.3), fem.ElementQuad2()),
+    (square(4, 0.3, kind="tri"), fem.ElementTriP2()),
+    (cube(2, 0.3), fem.ElementHex1()),
+    (cube(2, 0.3, kind="tet"), fem.ElementTetP2()),
+], ids=["Q1", "Q2", "T2", "H1", "O2"])
+def test_fe_cell_bases_fast_equals_generic(mesh_elem):
+    mesh, e = mesh_elem
+    d = mesh.dim()
+    vb = fem.Basis(mesh, fem.ElementVector(e))
+    form = linear_elasticity(*lame(10.0, 0.3))
+    assert rel(pg.assemble(form, vb), form.assemble(vb)) < 1e-13
+    rng = np.random.default_rng(1)
+    F = vb.interpolate(0.05 * rng.standard_normal(vb.N)).grad \
+        + np.eye(d)[:, :, None, None]
+    from skfem_pg.materials import NeoHooke
+    from skfem_pg.mechanics import material_tangent, internal_force
+    A = NeoHooke(3.0, 1.0).tangent(F)
+    P = NeoHooke(3.0, 1.0).stress(F)
+    assert rel(pg.assemble(material_tangent, vb, A=A),
+               material_tangent.assemble(vb, A=A)) < 1e-13
+    assert rel(pg.assemble(internal_force, vb, P=P),
+               internal_force.assemble(vb, P=P)) < 1e-13
+    sb = fem.Basis(mesh, e)
+
+    @fem.BilinearForm
+    def mass_diffusion(u, v, w):
+        return dot(grad(u), grad(v)) + (1 + w.x[0] ** 2) * u * v
+
+    assert rel(pg.assemble(mass_diffusion, sb),
+               mass_diffusion.assemble(sb)) < 1e-13

@@ -1,0 +1,222 @@
+"""Benchmark scenes: one problem, solved by PG or by an FE comparator on
+the same nodes with one call.
+
+A :class:`Scene` holds a mesh (the node set), a material, clamped and
+prescribed boundaries, dead-load tractions and probe points.
+``scene.solve("PG", **basis_kwargs)`` runs a :class:`~skfem_pg.FamilyBasis`
+(VC PBG Unl by default); ``scene.solve("Q1")`` etc. run scikit-fem elements
+on the same mesh:
+
+=======  =======================  =========================================
+method   mesh                     element
+=======  =======================  =========================================
+T1       triangles (quads split)  P1
+Q1       quadrilaterals           Q1
+Q1P0     quadrilaterals           Q1, mean dilatation (iso/vol neo-Hooke)
+O1       tetrahedra               P1
+H1       hexahedra                Q1
+H1P0     hexahedra                Q1, mean dilatation
+T2, Q2,  as above                 quadratic (for FE overkill references)
+O2, H2
+=======  =======================  =========================================
+
+Every solve reports wall time split into preprocess (basis, families,
+corrections), assemble and linear solve (summed over Newton iterations).
+"""
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import skfem as fem
+
+from .basis import FamilyBasis
+from .loads import traction as pg_traction
+from .materials import NeoHookeIsoVol
+from .mechanics import Hyperelastic, MeanDilatation
+from .particles import Particles
+from .solvers import newton
+
+#: method -> (mesh class needed, scalar element)
+FE_METHODS = {
+    "T1": (fem.MeshTri1, fem.ElementTriP1),
+    "T2": (fem.MeshTri1, fem.ElementTriP2),
+    "Q1": (fem.MeshQuad1, fem.ElementQuad1),
+    "Q1P0": (fem.MeshQuad1, fem.ElementQuad1),
+    "Q2": (fem.MeshQuad1, fem.ElementQuad2),
+    "O1": (fem.MeshTet1, fem.ElementTetP1),
+    "O2": (fem.MeshTet1, fem.ElementTetP2),
+    "H1": (fem.MeshHex1, fem.ElementHex1),
+    "H1P0": (fem.MeshHex1, fem.ElementHex1),
+    "H2": (fem.MeshHex1, fem.ElementHex2),
+}
+
+
+@dataclass
+class Result:
+    """A scene solution."""
+    method: str
+    u: np.ndarray
+    basis: object
+    probes: dict
+    times: dict
+    history: list = field(default_factory=list)
+
+    @property
+    def total_time(self):
+        return sum(self.times.values())
+
+
+class Scene:
+    """A nonlinear solid-mechanics problem on a node set.
+
+    Parameters
+    ----------
+    name
+        Label (also part of the overkill cache key).
+    mesh
+        Node set (scikit-fem mesh with named boundaries).
+    material
+        A :mod:`skfem_pg.materials` law.
+    clamped
+        Boundary names with ``u = 0``.
+    prescribed
+        ``{boundary: {component: value}}`` displacements at load factor 1.
+    tractions
+        ``{boundary: vector}`` dead-load tractions at load factor 1.
+    probes
+        ``{label: point}`` where displacements are reported.
+    steps
+        Initial number of load steps.
+
+    """
+
+    def __init__(self, name, mesh, material, clamped=(), prescribed=None,
+                 tractions=None, probes=None, steps=1, params=None):
+        self.name, self.mesh, self.material = name, mesh, material
+        self.clamped = tuple(clamped)
+        self.prescribed = prescribed or {}
+        self.tractions = tractions or {}
+        self.probes = {k: np.asarray(v, float)
+                       for k, v in (probes or {}).items()}
+        self.steps = steps
+        self.params = params or {}
+
+    @property
+    def dim(self):
+        return self.mesh.dim()
+
+    def key(self):
+        """Text that identifies the problem (mesh geometry excluded): name,
+        material, boundary conditions, loads, parameters."""
+        return repr((self.name, repr(self.material), self.clamped,
+                     sorted((k, sorted(v.items()))
+                            for k, v in self.prescribed.items()),
+                     sorted((k, list(map(float, v)))
+                            for k, v in self.tractions.items()),
+                     sorted(self.params.items())))
+
+    # -- bases ---------------------------------------------------------
+    def fe_mesh(self, method, mesh=None):
+        """The mesh a FE method runs on (triangles from quads, tets from
+        hexes by splitting: the same nodes)."""
+        mesh = self.mesh if mesh is None else mesh
+        need, _ = FE_METHODS[method]
+        if isinstance(mesh, need):
+            return mesh
+        if need is fem.MeshTri1 and isinstance(mesh, fem.MeshQuad1):
+            return _transfer_boundaries(mesh, mesh.to_meshtri())
+        if need is fem.MeshTet1 and isinstance(mesh, fem.MeshHex1):
+            return _transfer_boundaries(mesh, mesh.to_meshtet())
+        raise ValueError("{} needs a {} node set, the scene has a {}".format(
+            method, need.__name__, type(mesh).__name__))
+
+    def _dirichlet(self, basis):
+        D, u_D = [], np.zeros(basis.N)
+        for name in self.clamped:
+            D.append(basis.get_dofs(name).flatten())
+        for name, comps in self.prescribed.items():
+            dofs = basis.get_dofs(name)
+            for c, val in comps.items():
+                idx = dofs.nodal["u^{}".format(c + 1)]
+                D.append(idx)
+                u_D[idx] = val
+        D = np.unique(np.concatenate(D)) if D else np.zeros(0, int)
+        return D, u_D
+
+    def _fe_traction(self, basis, mesh, name, t):
+        fb = fem.FacetBasis(mesh, basis.elem, facets=name)
+        t = np.asarray(t, float)
+        return fem.LinearForm(
+            lambda v, w: sum(t[a] * v[a] for a in range(len(t)))
+        ).assemble(fb)
+
+    # -- solving -------------------------------------------------------
+    def solve(self, method="PG", mesh=None, verbose=False, solver="auto",
+              tangent="consistent", **basis_kwargs):
+        """Solve with ``"PG"`` (``basis_kwargs`` go to ``FamilyBasis``) or
+        an FE method of :data:`FE_METHODS`; returns a :class:`Result`."""
+        t0 = time.perf_counter()
+        if method == "PG":
+            mesh = self.mesh if mesh is None else mesh
+            basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
+                                **basis_kwargs)
+            model = Hyperelastic(basis, self.material, tangent=tangent)
+            f = sum((pg_traction(basis, n, t)
+                     for n, t in self.tractions.items()), np.zeros(basis.N))
+        elif method in FE_METHODS:
+            mesh = self.fe_mesh(method, mesh)
+            _, E = FE_METHODS[method]
+            basis = fem.Basis(mesh, fem.ElementVector(E()))
+            if method.endswith("P0"):
+                m = self.material
+                if not isinstance(m, NeoHookeIsoVol):
+                    raise ValueError("{} (mean dilatation) needs the iso/vol "
+                                     "neo-Hooke material".format(method))
+                model = MeanDilatation(basis, m.mu, m.K)
+            else:
+                model = Hyperelastic(basis, self.material)
+            f = sum((self._fe_traction(basis, mesh, n, t)
+                     for n, t in self.tractions.items()), np.zeros(basis.N))
+        else:
+            raise ValueError("unknown method {!r}: 'PG' or one of {}".format(
+                method, ", ".join(FE_METHODS)))
+        D, u_D = self._dirichlet(basis)
+        t_pre = time.perf_counter() - t0
+        u, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
+                         solver=solver, verbose=verbose)
+        times = {"preprocess": t_pre,
+                 "assemble": sum(h["t_assemble"] for h in hist),
+                 "solve": sum(h["t_linear"] for h in hist)}
+        return Result(method, u, basis, self.evaluate(basis, u), times, hist)
+
+    def evaluate(self, basis, u):
+        """Displacements at the probe points."""
+        out = {}
+        d = self.dim
+        for label, x in self.probes.items():
+            if isinstance(basis, FamilyBasis):
+                p = basis.particles
+                i = int(np.argmin(np.linalg.norm(p.x - x[:, None], axis=0)))
+                if np.linalg.norm(p.x[:, i] - x) > 1e-9 * max(1.0, np.abs(
+                        x).max()):
+                    raise ValueError("probe {} at {} is not a particle"
+                                     .format(label, tuple(x)))
+                out[label] = u.reshape(-1, d)[i].copy()
+            else:
+                out[label] = (basis.probes(x[:, None]) @ u).reshape(d)
+        return out
+
+
+def _transfer_boundaries(old, new):
+    """Named boundaries of ``old`` on ``new``, a split of ``old`` with the
+    same vertices: a boundary facet of ``new`` belongs to a name when all
+    its vertices lie on that name's facets."""
+    if not old.boundaries:
+        return new
+    bfacets = new.boundary_facets()
+    named = {}
+    for name, facets in old.boundaries.items():
+        on = np.zeros(old.nvertices, dtype=bool)
+        on[old.facets[:, facets].ravel()] = True
+        named[name] = bfacets[np.all(on[new.facets[:, bfacets]], axis=0)]
+    return new.with_boundaries(named)
