@@ -24,8 +24,8 @@ from skfem_pg.models import lame, linear_elasticity
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
 FORM = linear_elasticity(*lame(1.0, 0.3))
-#: SuperLU with a symmetric ordering, for Q1 and PG alike
-SOLVER = fem.utils.solver_direct_scipy(permc_spec="MMD_AT_PLUS_A")
+#: one direct solver for Q1 and PG alike (RCM + SuperLU, skfem_pg.solvers)
+SOLVER = pg.solvers.direct
 
 
 def clock(fn, *args, **kw):

@@ -33,9 +33,8 @@ OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
 POINT = np.array([48.0, 52.0])
 LITERATURE = 23.96
 
-#: one direct solver for every method: SuperLU with a symmetric ordering
-#: (scikit-fem's default COLAMD ordering is 2-4x slower on these matrices)
-SOLVER = fem.utils.solver_direct_scipy(permc_spec="MMD_AT_PLUS_A")
+#: one direct solver for every method (RCM + SuperLU, skfem_pg.solvers)
+SOLVER = pg.solvers.direct
 
 LAM, MU = lame(1.0, 1.0 / 3.0, plane_stress=True)
 FORM = linear_elasticity(LAM, MU)

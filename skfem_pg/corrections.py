@@ -161,6 +161,19 @@ def anchor_particles(x, active):
     return act[chosen]
 
 
+class _PermutedLU:
+    """SuperLU of ``A[p][:, p]`` solving ``A x = b``."""
+
+    def __init__(self, A, p):
+        self.p = p
+        self.lu = spl.splu(A[p][:, p].tocsc(), permc_spec="MMD_AT_PLUS_A")
+
+    def solve(self, b):
+        x = np.empty_like(b, dtype=float)
+        x[self.p] = self.lu.solve(b[self.p])
+        return x
+
+
 def scalar_constraint_matrix(phi, fam, n_particles):
     r"""Sparse :math:`\Phi^T` with entries :math:`\varphi^{ki}` (row ``i``,
     column ``k``), shape ``(np, nf)``."""
@@ -202,7 +215,12 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2):
                            "({} equations, {} unknowns)".format(len(rows),
                                                                 len(cols)))
     Ar = PhiT[rows].tocsc()
-    lu = spl.splu(Ar[:, cols], permc_spec="MMD_AT_PLUS_A")
+    # bandwidth-reducing permutation first: SuperLU's orderings alone are
+    # erratic on randomly numbered (e.g. gmsh) particle sets
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    Ac = Ar[:, cols].tocsr()
+    perm = reverse_cuthill_mckee(Ac, symmetric_mode=False)
+    lu = _PermutedLU(Ac, perm)
     bb = b.reshape(n, d)[rows]
     sol = lu.solve(np.column_stack([bb, -Ar[:, fix].toarray()]))
     if not np.all(np.isfinite(sol)):

