@@ -9,7 +9,7 @@ scikit-fem's own assembly, so the same ``BilinearForm`` assembles FE and PG.
 >>> basis.vc_report.residual_after < 1e-10
 True
 """
-from . import families, shape, corrections, meshing, materials, solvers
+from . import families, shape, corrections, meshing, materials, solvers, models
 from .errors import ParticleError, FamilyError, UnsupportedMeshError
 from .particles import Particles
 from .families import Families
@@ -23,5 +23,5 @@ __version__ = "0.1.0"
 __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "block_pattern", "traction", "stress_load", "body_force",
            "write_vtu", "families", "shape", "corrections", "meshing",
-           "materials", "solvers",
+           "materials", "solvers", "models",
            "ParticleError", "FamilyError", "UnsupportedMeshError"]

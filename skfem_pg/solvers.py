@@ -18,7 +18,14 @@ import scipy.sparse.linalg as spl
 
 
 class ConvergenceError(RuntimeError):
-    """Newton's method could not reach the requested load."""
+    """Newton's method could not reach the requested load.
+
+    ``load``, ``u`` and ``history`` hold the last converged state, so a
+    caller can report how far the loading got."""
+
+    def __init__(self, message, load=0.0, u=None, history=None):
+        super().__init__(message)
+        self.load, self.u, self.history = load, u, history or []
 
 
 def rigid_body_modes(doflocs):
@@ -170,13 +177,21 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             raise ConvergenceError(
                 "Newton failed at load factor {:.6g} ({}); the step fell "
                 "below min_step = {:.3g} after reaching load {:.6g}".format(
-                    target, info["reason"], min_step, lam))
+                    target, info["reason"], min_step, lam),
+                load=lam, u=u, history=history)
     return u, history
 
 
 def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
+    """Newton iterations at load factor ``lam`` from the converged ``u``.
+
+    The increment of the prescribed displacements enters the first linear
+    solve (``K_II du_I = -r_I - K_ID du_D``), so it is spread through the
+    body instead of distorting the boundary layer.
+    """
     u = u.copy()
-    u[Dd] = lam * u_D[Dd]
+    du_D = lam * u_D[Dd] - u[Dd]
+    pending = bool(np.any(du_D != 0))
     res = []
     info = {"residuals": res, "min_J": np.nan, "reason": "",
             "t_assemble": 0.0, "t_linear": 0.0}
@@ -196,24 +211,30 @@ def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
         if not np.isfinite(rn):
             info["reason"] = "non-finite residual"
             return False, u, info
-        if ref is None:
-            ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
-        if rn <= tol * ref or du_norm <= 1e-10 * np.abs(u).max():
-            return True, u, info
+        if not pending:
+            if ref is None:
+                ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
+            if rn <= tol * ref or du_norm <= 1e-10 * np.abs(u).max():
+                return True, u, info
+            if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
+                info["reason"] = "diverging"
+                return False, u, info
         if it == maxiter:
             info["reason"] = "maxiter"
             return False, u, info
-        if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
-            info["reason"] = "diverging"
-            return False, u, info
         t0 = time.perf_counter()
-        K = model.tangent(state)
+        K = model.tangent(state).tocsr()
         t1 = time.perf_counter()
         du = np.zeros_like(u)
-        du[I] = lin(K[I][:, I].tocsr(), -r[I])
+        rhs = -r[I]
+        if pending:
+            du[Dd] = du_D
+            rhs = rhs - K[I][:, Dd] @ du_D
+        du[I] = lin(K[I][:, I].tocsr(), rhs)
         info["t_assemble"] += t1 - t0
         info["t_linear"] += time.perf_counter() - t1
         du_norm = np.abs(du).max()
         u += du
+        pending = False
     info["reason"] = "maxiter"
     return False, u, info

@@ -64,9 +64,13 @@ def test_impossible_compression_reports_the_load_factor(beam):
     u_D = np.zeros(b.N)
     right = b.get_dofs("right").nodal["u^1"]
     u_D[right] = -5.0  # squeeze a bar of length 4 by 5
-    with pytest.raises(ConvergenceError, match="load factor"):
+    with pytest.raises(ConvergenceError, match="load factor") as err:
         newton(Hyperelastic(b, mat.NeoHooke(LAM, MU)), D=D, u_D=u_D, steps=2,
                min_step=1 / 16, verbose=False)
+    # the last converged state is reported: a bar of length 4 cannot be
+    # squeezed by more than 4
+    assert 0 < err.value.load < 0.8
+    assert np.all(err.value.u[right] == err.value.load * -5.0)
 
 
 def test_same_newton_on_scikit_fem_q1(beam):
