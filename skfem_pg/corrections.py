@@ -288,7 +288,6 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
     nf, m = mem.shape
     B = (dx[:, None, :] @ np.reshape(Q, (nf, m, d * d))).reshape(nf, d, d)
-    A = constraint_matrix(phi, B, fam, n)
     r0 = constraint_residual(G, dx, fam, area)
     b = -r0.ravel()
     # the part of b outside range(A) (e.g. volumes that do not add up to
@@ -298,8 +297,14 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     if solver == "auto":
         solver = "direct"
     notes = []
+    unknowns = d * nf
+
+    def lsqr():  # the full block system, only built when needed
+        A = constraint_matrix(phi, B, fam, n)
+        return _solve_lsqr(A, b, tol, maxiter or 20 * unknowns)
+
     if solver == "lsqr":
-        alpha, its = _solve_lsqr(A, b, tol, maxiter or 20 * A.shape[1])
+        alpha, its = lsqr()
     elif solver == "direct":
         try:
             alpha, its = _solve_pinned_lu(phi, B, b, x, active, fam)
@@ -307,7 +312,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
             notes.append("direct solve failed ({}); fell back to LSQR"
                          .format(err))
             solver = "lsqr"
-            alpha, its = _solve_lsqr(A, b, tol, maxiter or 20 * A.shape[1])
+            alpha, its = lsqr()
     else:
         raise ValueError("unknown VC solver {!r}: use 'direct', 'lsqr' or "
                          "'auto'".format(solver))
@@ -315,7 +320,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]  # (nf,m,d)
     Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # phi is 0 if padded
     r1 = constraint_residual(Gc, dx, fam, area)
-    rep = VCReport(variant=variant, solver=solver, unknowns=A.shape[1],
+    rep = VCReport(variant=variant, solver=solver, unknowns=unknowns,
                    constraints=int(active.sum()) * d,
                    residual_before=float(np.abs(r0[active]).max()
                                          / area_scale),

@@ -94,3 +94,18 @@ def test_bad_options_are_named():
         pg.FamilyBasis(p, bond=False, vc="V5")
     with pytest.raises(ValueError, match="V2"):
         pg.FamilyBasis(p, vc="V2")
+
+
+def test_vc_falls_back_to_lsqr_when_a_particle_masters_no_family():
+    mesh = square(4, 0.2)
+    p = pg.Particles.from_mesh(mesh)
+    fam = pg.families.from_mesh(p)
+    keep = np.arange(len(fam) - 1)  # drop the last family
+    sub = pg.Families(np.r_[0, np.cumsum(fam.sizes[keep])],
+                      np.concatenate([fam.members[fam.offsets[k]:
+                                                  fam.offsets[k + 1]]
+                                      for k in keep]), p.n)
+    with pytest.warns(UserWarning, match="constraint residual"):
+        b = pg.FamilyBasis(p, sub, dim=2)
+    assert b.vc_report.solver == "lsqr"
+    assert "fell back to LSQR" in b.vc_report.notes[0]
