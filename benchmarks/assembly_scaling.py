@@ -34,7 +34,16 @@ def clock(fn, *args, **kw):
     return out, time.perf_counter() - t0
 
 
-def run(n, generic=False, pg_solve=False):
+def amg_solve(K, f, D, doflocs):
+    """CG + pyamg smoothed aggregation with rigid body modes."""
+    I = np.setdiff1d(np.arange(K.shape[0]), D)
+    x = np.zeros(K.shape[0])
+    x[I] = pg.solvers.linear_solver("amg", doflocs[:, I], tol=1e-10)(
+        K[I][:, I].tocsr(), f[I])
+    return x
+
+
+def run(n, generic=False, pg_solve=False, amg=False):
     mesh = pg.meshing.distort(
         fem.MeshQuad.init_tensor(*[np.linspace(0, 1, n + 1)] * 2), 0.3,
         seed=n)
@@ -51,6 +60,9 @@ def run(n, generic=False, pg_solve=False):
     uq, r["q1_solve"] = clock(
         lambda: fem.solve(*fem.condense(Kq, f, D=D), solver=SOLVER))
     r["q1_nnz"] = int(Kq.nnz)
+    Dflat = D.flatten()
+    if amg:
+        _, r["q1_solve_amg"] = clock(amg_solve, Kq, f, Dflat, q1.doflocs)
     # --- PG ------------------------------------------------------------
     t0 = time.perf_counter()
     particles, r["pg_particles"] = clock(pg.Particles.from_mesh, mesh)
@@ -70,13 +82,15 @@ def run(n, generic=False, pg_solve=False):
         u, r["pg_solve"] = clock(
             lambda: fem.solve(*fem.condense(K, f, D=D), solver=SOLVER))
         r["tip_pg_vs_q1"] = float(u[-1] / uq[-1])
+    if amg:
+        _, r["pg_solve_amg"] = clock(amg_solve, K, f, Dflat, basis.doflocs)
     r["ratio_asm"] = r["pg_assemble"] / r["q1_assemble"]
     r["ratio_asm_first"] = r["pg_assemble_first"] / r["q1_assemble"]
     r["ratio_pre_q1solve"] = r["pg_preprocess"] / r["q1_solve"]
     return r
 
 
-def main(sizes):
+def main(sizes, amg=False):
     rows = []
     hdr = ("{:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s}"
            " {:>8s} {:>8s} {:>9s} {:>9s}")
@@ -84,7 +98,7 @@ def main(sizes):
                      "asm", "Q1asm", "Q1solve", "PGsolve", "asm/Q1",
                      "pre/Q1slv"))
     for n in sizes:
-        r = run(n, generic=n <= 100, pg_solve=True)
+        r = run(n, generic=n <= 100, pg_solve=True, amg=amg)
         rows.append(r)
         print("{:8d} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} "
               "{:8.2f} {:8.2f} {:>8s} {:9.2f} {:9.2f}".format(
@@ -104,6 +118,13 @@ def main(sizes):
                   np.log(b["pg_assemble"] / a["pg_assemble"]) / g,
                   np.log(b["q1_assemble"] / a["q1_assemble"]) / g,
                   np.log(b["q1_solve"] / a["q1_solve"]) / g))
+    for r in rows:
+        if amg:
+            print("{:8d} particles, AMG-CG (rigid body modes): Q1 {:.2f} s, "
+                  "PG {:.2f} s, PG/Q1 {:.2f} (direct: {:.2f})".format(
+                      r["particles"], r["q1_solve_amg"], r["pg_solve_amg"],
+                      r["pg_solve_amg"] / r["q1_solve_amg"],
+                      r["pg_solve"] / r["q1_solve"]))
     if rows and "pg_assemble_generic" in rows[0]:
         r = rows[0]
         print("generic scikit-fem path on PG at {} particles: {:.2f} s "
@@ -122,4 +143,7 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--sizes", type=int, nargs="+",
                     default=[100, 200, 300, 400, 500])
-    main(ap.parse_args().sizes)
+    ap.add_argument("--amg", action="store_true",
+                    help="also time CG + smoothed aggregation solves")
+    a = ap.parse_args()
+    main(a.sizes, a.amg)
