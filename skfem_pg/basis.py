@@ -192,9 +192,9 @@ class FamilyBasis(AbstractBasis):
             q = fam.members[np.nonzero(inactive)[0][0]]
             raise FamilyError("{} has zero volume but is a family member"
                               .format(describe_particle(q, p.x[:, q])))
-        need = p.dim + 1 if self.shape in ("MTE1", "WTE1") else p.dim + 2
-        if self.vc is not None:
-            need = p.dim + 2  # MLS1 at the master without the master
+        # linear Taylor expansions need d others; MLS1 at the master
+        # (VC correction) needs d + 1 others
+        need = p.dim + 2 if self.vc is not None else p.dim + 1
         families_mod.check_supports(p, fam, need, "{}{}".format(
             self.shape, " with VC correction" if self.vc else ""))
 

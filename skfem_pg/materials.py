@@ -14,7 +14,7 @@ Tangents are verified against central finite differences in
 import numpy as np
 
 
-def _inv_det(F):
+def inverse_and_det(F):
     """Inverse and determinant of ``(d, d, ...)`` arrays."""
     Fm = np.moveaxis(F, (0, 1), (-2, -1))
     return np.moveaxis(np.linalg.inv(Fm), (-2, -1), (0, 1)), np.linalg.det(Fm)
@@ -134,12 +134,12 @@ class NeoHooke(Material):
         self.lam, self.mu = float(lam), float(mu)
 
     def stress(self, F):
-        Finv, J = _inv_det(F)
+        Finv, J = inverse_and_det(F)
         FinvT = np.swapaxes(Finv, 0, 1)
         return self.mu * F + (0.5 * self.lam * (J ** 2 - 1) - self.mu) * FinvT
 
     def tangent(self, F):
-        Finv, J = _inv_det(F)
+        Finv, J = inverse_and_det(F)
         FinvT = np.swapaxes(Finv, 0, 1)
         c = 0.5 * self.lam * (J ** 2 - 1) - self.mu
         return (self.mu * _identity4(F)
@@ -147,7 +147,7 @@ class NeoHooke(Material):
                 + c * _inv_t_derivative(Finv))
 
     def energy(self, F):
-        _, J = _inv_det(F)
+        _, J = inverse_and_det(F)
         d = F.shape[0]
         trC = np.einsum("kI...,kI...->...", F, F) + (3 - d)
         lnJ = np.log(J)
@@ -170,7 +170,7 @@ class NeoHookeIsoVol(Material):
         return cls(mu, lam + 2.0 * mu / 3.0)
 
     def stress(self, F):
-        Finv, J = _inv_det(F)
+        Finv, J = inverse_and_det(F)
         FinvT = np.swapaxes(Finv, 0, 1)
         d = F.shape[0]
         c = np.einsum("kI...,kI...->...", F, F) + (3 - d)  # tr C (3-D)
@@ -179,7 +179,7 @@ class NeoHookeIsoVol(Material):
                 + 0.5 * self.K * (J ** 2 - 1) * FinvT)
 
     def tangent(self, F):
-        Finv, J = _inv_det(F)
+        Finv, J = inverse_and_det(F)
         FinvT = np.swapaxes(Finv, 0, 1)
         d = F.shape[0]
         c = np.einsum("kI...,kI...->...", F, F) + (3 - d)
@@ -195,7 +195,7 @@ class NeoHookeIsoVol(Material):
         return iso + vol
 
     def energy(self, F):
-        _, J = _inv_det(F)
+        _, J = inverse_and_det(F)
         d = F.shape[0]
         trb = np.einsum("kI...,kI...->...", F, F) + (3 - d)
         return (0.5 * self.mu * (J ** (-2.0 / 3.0) * trb - 3)

@@ -31,7 +31,7 @@ import skfem as fem
 from skfem.helpers import ddot, grad
 
 from .assembly import assemble
-from .materials import NeoHookeIsoVol
+from .materials import NeoHookeIsoVol, inverse_and_det
 from .tangents import fd_tangent
 
 
@@ -122,15 +122,13 @@ class MeanDilatation(Hyperelastic):
 
     def stress(self, state):
         F, J = state["F"], state["J"]
-        FinvT = np.swapaxes(np.moveaxis(np.linalg.inv(
-            np.moveaxis(F, (0, 1), (-2, -1))), (-2, -1), (0, 1)), 0, 1)
+        FinvT = np.swapaxes(inverse_and_det(F)[0], 0, 1)
         p = self._pressure(state["Theta"])[:, None]
         return self.material.stress(F) + p * J * FinvT
 
     def tangent(self, state):
         F, J, Theta = state["F"], state["J"], state["Theta"]
-        Finv = np.moveaxis(np.linalg.inv(np.moveaxis(F, (0, 1), (-2, -1))),
-                           (-2, -1), (0, 1))
+        Finv = inverse_and_det(F)[0]
         FinvT = np.swapaxes(Finv, 0, 1)
         p = self._pressure(Theta)[:, None]
         # d(J F^-T)/dF = J (F^-T (x) F^-T - F^-1_Jk F^-1_Li)
