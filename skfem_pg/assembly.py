@@ -20,7 +20,9 @@ scalars).  The local matrices
         C_{(a\beta)(c\gamma)}^{kj}\, \hat G^{kji}_\beta \hat G^{kjl}_\gamma,
     \qquad \hat G^{kji} = (N^{kji}, G^{kji}),
 
-are batched matrix products, scattered into a block sparsity pattern that is
+(a form may instead provide them as ``form.coefficients(w, c, d + 1)``,
+shape ``(ne, nq, c(d+1), c(d+1))``) are batched matrix products, scattered
+into a block sparsity pattern that is
 computed once per basis.  For a family basis ``k`` is a family, ``j`` a
 member (quadrature point) and ``i`` a member (basis function) with
 :math:`N^{kji} = \delta_{ij}`; for a scikit-fem cell basis ``k`` is an
@@ -215,9 +217,12 @@ def _assemble_bilinear(form, basis, view, kwargs):
     ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
     nch = view.dim + 1
     # C[p, q]: p = trial probe (a, β), q = test probe (c, γ)
-    values = [[_call(form, pu, pv, w) for (_, _, pv) in probes]
-              for (_, _, pu) in probes]
-    C, const = _coefficients(values, (ne, nq))
+    if hasattr(form, "coefficients"):  # the form knows them: no probing
+        C, const = form.coefficients(w, view.nc, nch), False
+    else:
+        values = [[_call(form, pu, pv, w) for (_, _, pv) in probes]
+                  for (_, _, pu) in probes]
+        C, const = _coefficients(values, (ne, nq))
     ch = _used_channels(C, nc, nch)
     sel = [a * nch + b for a in range(nc) for b in ch]
     C = C[..., sel, :][..., :, sel]

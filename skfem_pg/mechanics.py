@@ -50,6 +50,20 @@ def material_tangent(du, v, w):
     return ddot(Adu, grad(v))
 
 
+def _tangent_coefficients(w, nc, nch):
+    """Probe coefficients of :func:`material_tangent` for the batched
+    assembly: trial ``(a, 1+b)``, test ``(c, 1+e)`` -> ``A[c, e, a, b]``;
+    values do not enter."""
+    A = np.asarray(w.A)
+    d = A.shape[0]
+    C = np.zeros(A.shape[4:] + (nc, nch, nc, nch))
+    C[..., :, 1:, :, 1:] = np.moveaxis(A, (0, 1, 2, 3), (-2, -1, -4, -3))
+    return C.reshape(A.shape[4:] + (nc * nch, nc * nch))
+
+
+material_tangent.coefficients = _tangent_coefficients
+
+
 def _dim(basis):
     return basis.particles.dim if hasattr(basis, "particles") else \
         basis.mesh.dim()

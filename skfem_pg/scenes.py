@@ -51,6 +51,11 @@ FE_METHODS = {
 }
 
 
+#: Gauss rules of the multilinear/multiquadratic elements: 2 and 3 points
+#: per direction (scikit-fem's defaults use 3 and 7); simplices: defaults
+INTORDER = {"Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2, "Q2": 4, "H2": 4}
+
+
 @dataclass
 class Result:
     """A scene solution."""
@@ -166,7 +171,8 @@ class Scene:
         elif method in FE_METHODS:
             mesh = self.fe_mesh(method, mesh)
             _, E = FE_METHODS[method]
-            basis = fem.Basis(mesh, fem.ElementVector(E()))
+            basis = fem.Basis(mesh, fem.ElementVector(E()),
+                              intorder=INTORDER.get(method))
             if method.endswith("P0"):
                 m = self.material
                 if not isinstance(m, NeoHookeIsoVol):
