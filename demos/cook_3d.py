@@ -28,6 +28,7 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
+from skfem_pg.reporting import save_error_vs_time, wall_time
 from skfem_pg.scenes import Scene
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
@@ -35,6 +36,7 @@ T, Q = 10.0, 4.0
 CORNER = (48.0, 60.0, T)
 MATERIAL = mat.NeoHookeIsoVol.from_lame(100.0, 40.0)
 METHODS = {"O1": ("O1", {}), "H1P0": ("H1P0", {}), "VC PBG Unl": ("PG", {})}
+STYLES = {"O1": "k--o", "H1P0": "k-s", "VC PBG Unl": "C0-D"}
 
 
 def cook3d(n, nz, distortion=0.0, seed=0):
@@ -87,35 +89,17 @@ def main(sizes=(4, 8, 12, 16)):
     for n in sizes:
         sel = {r["method"]: r for r in rows if r["n"] == n}
         pgr, o1 = sel["VC PBG Unl"], sel["O1"]
-        t = lambda r: r["preprocess"] + r["assemble"] + r["solve"]
         print("  {:6d} nodes: {:.2f}, {:.2f}".format(
-            pgr["nodes"], pgr["err"] / o1["err"], t(pgr) / t(o1)))
+            pgr["nodes"], pgr["err"] / o1["err"],
+            wall_time(pgr) / wall_time(o1)))
     os.makedirs(OUT, exist_ok=True)
-    plot(rows, os.path.join(OUT, "cook_3d.png"))
+    save_error_vs_time(os.path.join(OUT, "cook_3d.png"), rows, STYLES,
+                       "relative error of w(48, 60, 10)",
+                       "3-D Cook's membrane, ±0.3h distorted node sets")
     pg.write_vtu(os.path.join(OUT, "cook_3d.vtu"), last.basis.particles,
                  **particle_fields(last.basis, MATERIAL, last.u))
     print("wrote demos/out/cook_3d.png and cook_3d.vtu")
     return rows
-
-
-def plot(rows, fn):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
-    for name, st in {"O1": "k--o", "H1P0": "k-s",
-                     "VC PBG Unl": "C0-D"}.items():
-        sel = [r for r in rows if r["method"] == name]
-        ax.loglog([r["preprocess"] + r["assemble"] + r["solve"]
-                   for r in sel], [r["err"] for r in sel], st, label=name)
-    ax.axhline(0.01, color="0.5", lw=0.8)
-    ax.set_xlabel("wall time (preprocess + assemble + solve) [s]")
-    ax.set_ylabel("relative error of w(48, 60, 10)")
-    ax.set_title("3-D Cook's membrane, ±0.3h distorted node sets")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
-    fig.tight_layout()
-    fig.savefig(fn, dpi=120)
 
 
 if __name__ == "__main__":

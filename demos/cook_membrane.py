@@ -28,6 +28,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.reporting import plot_error_vs_time
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
 POINT = np.array([48.0, 52.0])
@@ -157,15 +158,12 @@ def plot(rows, ref, fn):
     styles = {"T1": "k--o", "Q1": "k-s", "PBG U1": "C1-^",
               "PBG Unl": "C2-v", "VC PBG Unl": "C0-D"}
     for ax, label in zip(axes, ("regular", "irregular")):
-        for name, st in styles.items():
-            sel = [r for r in rows if r[0] == label and r[2] == name]
-            ax.loglog([sum(r[4]) for r in sel],
-                      [abs(r[3] - ref) / ref for r in sel], st, label=name)
-        ax.set_title("Cook's membrane, {} node sets".format(label))
-        ax.set_xlabel("wall time (preprocess + assemble + solve) [s]")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].set_ylabel("relative error of v(48, 52)")
-    axes[0].legend()
+        sel = [dict(method=name, err=abs(v - ref) / ref,
+                    **dict(zip(("preprocess", "assemble", "solve"), t)))
+               for lab, n, name, v, t in rows if lab == label]
+        plot_error_vs_time(ax, sel, styles, "relative error of v(48, 52)",
+                           "Cook's membrane, {} node sets".format(label),
+                           target=None)
     fig.tight_layout()
     fig.savefig(fn, dpi=120)
 

@@ -1,0 +1,40 @@
+"""Reporting benchmark runs: wall time and error-against-time plots.
+
+A *row* is a dict with at least ``method``, ``err`` and the time split
+``preprocess``, ``assemble``, ``solve`` (as in
+:attr:`skfem_pg.scenes.Result.times`).
+"""
+
+
+def wall_time(row):
+    """Preprocess + assemble + solve seconds of a row."""
+    return row["preprocess"] + row["assemble"] + row["solve"]
+
+
+def plot_error_vs_time(ax, rows, styles, ylabel, title, target=0.01):
+    """Log-log error against wall time, one line per method in ``styles``
+    (``{method: matplotlib format}``), with a horizontal line at
+    ``target``."""
+    for name, st in styles.items():
+        sel = [r for r in rows if r["method"] == name]
+        ax.loglog([wall_time(r) for r in sel], [r["err"] for r in sel], st,
+                  label=name)
+    if target:
+        ax.axhline(target, color="0.5", lw=0.8)
+    ax.set_xlabel("wall time (preprocess + assemble + solve) [s]")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+
+
+def save_error_vs_time(fn, rows, styles, ylabel, title, target=0.01):
+    """One-panel :func:`plot_error_vs_time` written to ``fn`` (PNG)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    plot_error_vs_time(ax, rows, styles, ylabel, title, target)
+    fig.tight_layout()
+    fig.savefig(fn, dpi=120)
+    plt.close(fig)
