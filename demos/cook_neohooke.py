@@ -14,6 +14,8 @@ Methods on each node set (meshes/cook.geo, element sizes --sizes):
   PBG Unl                  MTE1 + bond correction, no VC
   VC PBG Unl               MTE1 + bond correction + V5 (default FamilyBasis)
   VC PBG Unl (FD tangent)  the same with a finite-difference tangent
+  VC PPG Unl               Petrov-Galerkin PPG1: MTE1 trial, WTE1 test
+                           derivatives at the masters + V3 (non-symmetric)
 
 Prints error, L2 error at the particles and wall time (preprocess /
 assemble / solve), the time each method needs for 1 % tip error, and the
@@ -44,10 +46,11 @@ METHODS = {
     "PBG Unl": ("PG", {"vc": None}),
     "VC PBG Unl": ("PG", {}),
     "VC PBG Unl (FD tangent)": ("PG", {"tangent": "fd"}),
+    "VC PPG Unl": ("PG", {"method": "PPG1"}),
 }
 
 STYLES = {"T1": "k--o", "PBG Unl": "C2-v", "VC PBG Unl": "C0-D",
-          "VC PBG Unl (FD tangent)": "C3:x"}
+          "VC PBG Unl (FD tangent)": "C3:x", "VC PPG Unl": "C1-s"}
 
 
 def scene(mesh):

@@ -13,7 +13,7 @@ quadrature:
 import numpy as np
 import skfem as fem
 
-from .basis import FamilyBasis
+from .basis import FamilyBasis, pbg_weights
 from .assembly import assemble
 from .loads import stress_load
 from .models import lame, linear_elasticity
@@ -37,12 +37,16 @@ def l2_error(basis, u, exact):
 
 def h1_error(basis, u, exact_grad):
     """Discrete H1 seminorm error; ``exact_grad(x)`` returns
-    ``(ncomp, dim, ...)`` at member positions ``x`` (``(dim, nf, m)``)."""
+    ``(ncomp, dim, ...)`` at member positions ``x`` (``(dim, nf, m)``).
+    The quadrature is the PBG one, :math:`w_{kj} = V^kV^j/V_H^k`, for PPG
+    bases too (their weights :math:`V^j` count each particle once per
+    family it belongs to)."""
     g = basis.interpolate(u).grad
     x = basis.global_coordinates()
     ge = np.broadcast_to(exact_grad(np.asarray(x)), g.shape)
     err = ((g - ge) ** 2).reshape(-1, *g.shape[-2:]).sum(axis=0)
-    return float(np.sqrt(np.sum(basis.dx * err)))
+    return float(np.sqrt(np.sum(
+        pbg_weights(basis.particles.volumes, basis.families) * err)))
 
 
 def linear_patch_test(mesh, neumann, gradient=None, E=100.0, nu=0.3,

@@ -154,14 +154,10 @@ def _coefficients(values, shape):
 
 def _used_channels(C, nc, nch):
     """Channels (value/derivatives) with a non-zero coefficient."""
-    used = []
-    for beta in range(nch):
-        idx = [a * nch + beta for a in range(nc)]
-        sub = np.concatenate([np.take(C, idx, axis=-2).ravel(),
-                              np.take(C, idx, axis=-1).ravel()])
-        if np.any(sub != 0):
-            used.append(beta)
-    return used or [1]
+    nz = np.asarray(C != 0).reshape(-1, nc, nch, nc, nch)
+    used = np.flatnonzero(nz.any(axis=(0, 1, 3, 4))
+                          | nz.any(axis=(0, 1, 2, 3)))
+    return [int(b) for b in used] or [1]
 
 
 def _setup(form, basis, view, kwargs):
@@ -212,7 +208,7 @@ def block_pattern(basis, view=None):
     return basis._pattern
 
 
-def _assemble_bilinear(form, basis, view, kwargs):
+def _assemble_bilinear(form, basis, view, vview, kwargs):
     w, probes = _setup(form, basis, view, kwargs)
     ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
     nch = view.dim + 1
@@ -229,44 +225,53 @@ def _assemble_bilinear(form, basis, view, kwargs):
     nb = len(ch)
 
     def local_matrices(sl):
-        Gh = view.ext_grad(sl, ch)  # (k, j, i, β)
-        X = Gh * view.dx[sl][:, :, None, None]
-        nfc = X.shape[0]
+        Gh = view.ext_grad(sl, ch)  # trial (k, j, i, β)
+        Gv = Gh if vview is view else vview.ext_grad(sl, ch)  # test
+        nfc = Gh.shape[0]
+        # GT[k, i, (j, β)] = w_kj Ĝ[k, j, i, β]
+        GT = (Gh * view.dx[sl][:, :, None, None]).transpose(0, 2, 1, 3) \
+            .reshape(nfc, 1, m, nq * nb)
+        # Ca[k, a, j, (β, c), γ] = C[k, j, (a, β), (c, γ)]
         if const:
-            # T[k, j, i, a, c, γ] = sum_β X[k, j, i, β] C[a, β, c, γ]
-            T = np.tensordot(X, C.reshape(nc, nb, nc, nb), axes=([3], [1]))
+            Ca = C.reshape(1, nc, 1, nb * nc, nb)
         else:
-            Ck = C[sl].reshape((nfc, nq, nc, nb, nc, nb))
-            Ck = Ck.transpose(0, 1, 3, 2, 4, 5).reshape(nfc, nq, nb, -1)
-            T = np.matmul(X, Ck).reshape(nfc, nq, m, nc, nc, nb)
-        # K[k, i, a, c, l] = sum_{j, γ} T[k, j, i, a, c, γ] Ĝ[k, j, l, γ]
-        Tm = T.transpose(0, 2, 3, 4, 1, 5).reshape(nfc, m * nc * nc,
-                                                   nq * nb)
-        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nb, m)
-        K = np.matmul(Tm, Gm).reshape(nfc, m, nc, nc, m)
-        # block (row l, col i) holds K[(l, c), (i, a)] as [c, a]
-        return K.transpose(0, 4, 1, 3, 2)
+            Ca = C[sl].reshape(nfc, nq, nc, nb * nc, nb).transpose(
+                0, 2, 1, 3, 4)
+        # Y[k, a, (j, β), (c, l)] = sum_γ Ca[k, a, j, (β, c), γ] Ĝv[k, j, l, γ]
+        Y = np.empty((nfc, nc, nq, nb * nc, m))  # matmul's own output
+        np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None], out=Y)  # may be
+        Y = Y.reshape(nfc, nc, nq * nb, nc * m)  # strided: reshape copies
+        # K[k, a, i, c, l] = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
+        return np.matmul(GT, Y).reshape(nfc, nc, m, nc, m)
 
-    return assemble_local(basis, local_matrices, view)
+    return assemble_local(basis, local_matrices, view, transposed=True)
 
 
-def assemble_local(basis, local_matrices, view=None):
+def assemble_local(basis, local_matrices, view=None, transposed=False):
     """Sparse matrix from local element/family matrices.
 
     ``local_matrices(sl)`` returns, for the elements ``sl``, an array of
     shape ``(ne, m, m, c, c)``: block ``[k, l, i]`` couples row node ``l``
     (test) with column node ``i`` (trial), components ``[c_l, c_i]``.
-    Blocks are summed into the cached :func:`block_pattern`.
+    With ``transposed=True`` it returns the component-major transpose
+    ``(ne, c, m, c, m)`` indexed ``[k, c_i, i, c_l, l]`` instead (what a
+    batched product yields without a strided copy).  Blocks are summed
+    into the cached :func:`block_pattern`.
     """
     view = _view(basis) if view is None else view
     nc = view.nc
     indptr, indices, pieces = block_pattern(basis, view)
     data = np.zeros((len(indices), nc, nc))
     for sl, u, inv in pieces:
-        K = local_matrices(sl).reshape(-1, nc * nc)
-        acc = np.stack([np.bincount(inv, weights=K[:, q], minlength=len(u))
-                        for q in range(nc * nc)], axis=-1)
-        data[u] += acc.reshape(len(u), nc, nc)
+        K = local_matrices(sl)
+        if transposed:
+            m = K.shape[2]
+            inv = inv.reshape(-1, m, m).transpose(0, 2, 1).ravel()
+        for c in range(nc):
+            for a in range(nc):
+                Kca = K[:, a, :, c, :] if transposed else K[..., c, a]
+                data[u, c, a] += np.bincount(inv, weights=Kca.ravel(),
+                                             minlength=len(u))
     N = basis.N
     if nc == 1:
         return sp.csr_matrix((data[:, 0, 0], indices, indptr), shape=(N, N))
@@ -302,16 +307,29 @@ def assemble(form, basis, vbasis=None, **kwargs):
     """Assemble ``form`` on ``basis`` with batched local matrices.
 
     Works for :class:`FamilyBasis` and scikit-fem cell bases (scalar or
-    ``ElementVector``) when no different test basis is given; anything else
-    is passed on to ``form.assemble``.  The result equals
-    ``form.assemble(basis, **kwargs)`` (``tests/test_assembly.py``).
+    ``ElementVector``); the result equals ``form.assemble(basis, **kwargs)``
+    (``tests/test_assembly.py``).  The test basis is ``vbasis``, by default
+    ``basis`` itself or, for a Petrov–Galerkin family basis, ``basis.test``
+    (also for linear forms: PPG internal forces).  Other combinations are
+    passed on to ``form.assemble``.
     """
-    view = _view(basis) if (vbasis is None or vbasis is basis) else None
-    if view is not None:
-        if isinstance(form, BilinearForm):
-            return _assemble_bilinear(form, basis, view, kwargs)
-        if isinstance(form, LinearForm):
-            return _assemble_linear(form, basis, view, kwargs)
     if vbasis is None:
+        vbasis = getattr(basis, "test", None) or basis
+    view = _view(basis)
+    if vbasis is basis:
+        vview = view
+    elif (isinstance(basis, FamilyBasis) and isinstance(vbasis, FamilyBasis)
+          and vbasis.families is basis.families):
+        vview = _FamilyView(vbasis)
+    else:
+        vview = None
+    if view is not None and vview is not None:
+        if isinstance(form, BilinearForm):
+            return _assemble_bilinear(form, basis, view, vview, kwargs)
+        if isinstance(form, LinearForm):
+            return _assemble_linear(form, basis, vview, kwargs)
+    if isinstance(form, LinearForm):
+        return form.assemble(vbasis, **kwargs)
+    if vbasis is basis:
         return form.assemble(basis, **kwargs)
     return form.assemble(basis, vbasis, **kwargs)

@@ -17,12 +17,19 @@ Peridynamic Bubnov–Galerkin (PBG) method:
     \delta W = \sum_k \sum_{j\in H^k} w_{kj}\, P(F^{kj}) : \delta F^{kj},
     \qquad F^{kj} = I + \sum_i u^i\otimes G^{kji}.
 
+Petrov–Galerkin (``method="PPG1"``/``"PPG2"``, :mod:`skfem_pg.petrov`): the
+same elements with weights :math:`V^k` and a separate test basis
+``basis.test`` (derivatives at the masters, VC-corrected); assemble with
+:func:`skfem_pg.assemble`, which picks ``basis.test`` up, or with
+scikit-fem's ``form.assemble(basis, basis.test)``.
+
 Degrees of freedom follow scikit-fem's nodal numbering of the mesh the
 particles were collocated from (vector dof ``c`` of particle ``p`` is
 ``dim * p + c``), so family bases and FE bases on the same mesh add into one
 system.  Families are padded to the largest size ``m``; padded slots have
 zero weight and zero gradient.
 """
+import copy
 import time
 
 import numpy as np
@@ -31,12 +38,23 @@ from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
 from . import families as families_mod
+from . import petrov
 from .corrections import bond_correction, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS, mls1_master_values
 
-METHODS = ("PBG",)
+METHODS = ("PBG", "PPG1", "PPG2")
+
+
+def pbg_weights(volumes, families):
+    """PBG quadrature weights :math:`w_{kj} = V^k V^j / V_H^k` (4.30),
+    ``(nf, m)``, zero in padded slots; they sum to :math:`V^k` per
+    family."""
+    mem, mask = families.padded()
+    Vm = volumes[mem] * mask
+    return volumes[families.masters][:, None] * Vm / Vm.sum(axis=1,
+                                                           keepdims=True)
 
 
 class FamilyBasis(AbstractBasis):
@@ -45,7 +63,8 @@ class FamilyBasis(AbstractBasis):
     Parameters
     ----------
     particles
-        :class:`~skfem_pg.Particles`.
+        :class:`~skfem_pg.Particles`, or a scikit-fem mesh (its vertices
+        become particles, :meth:`Particles.from_mesh`).
     families
         :class:`~skfem_pg.families.Families`; default: mesh connectivity
         (``families.from_mesh``) for mesh particles, otherwise a horizon of
@@ -55,13 +74,19 @@ class FamilyBasis(AbstractBasis):
         ``"WTE1"`` (static Taylor expansion = classical correspondence,
         formulation U1).
     bond
-        Bond correction (5.55).  Default: on for MTE1, off for WTE1.
+        Bond correction (5.55).  Default: on for MTE1 (PBG and PPG:
+        VC PPG1 without it has negative eigenvalues on the free block,
+        ``tests/test_eigen.py``), off for WTE1.
     vc
         Variationally consistent correction: ``"V5"`` (default with bond
-        correction), ``"V3"`` (default for MTE1 without bond correction) or
+        correction), ``"V3"`` (default for MTE1 without bond correction,
+        and the only one for PPG, applied to its test derivatives) or
         ``None`` (default for WTE1: the classical, uncorrected method).
     method
-        ``"PBG"`` (Peridynamic Bubnov–Galerkin).
+        ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
+        ``"PPG1"`` or ``"PPG2"`` (Peridynamic Petrov–Galerkin (4.21),
+        (4.22): non-symmetric, test basis ``basis.test``; families are
+        completed to pairwise ones; PPG2 without VC for now).
     dim
         Number of field components: ``None`` for a scalar field (e.g.
         Poisson), the spatial dimension for displacements.
@@ -79,7 +104,11 @@ class FamilyBasis(AbstractBasis):
     G
         ``(nf, m, m, d)`` corrected derivatives :math:`G^{kji}`.
     dx
-        ``(nf, m)`` weights :math:`w_{kj}`.
+        ``(nf, m)`` weights :math:`w_{kj}` (PPG: :math:`V^j`).
+    test
+        PPG only: the test basis (same families, dofs and weights, test
+        derivatives of :func:`skfem_pg.petrov.test_gradients`); ``None``
+        for PBG.
     vc_report
         :class:`~skfem_pg.corrections.VCReport` (``None`` without VC).
     timings
@@ -90,8 +119,11 @@ class FamilyBasis(AbstractBasis):
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None):
+        if isinstance(particles, fem.Mesh):
+            particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
-            raise TypeError("particles must be a skfem_pg.Particles, got {}"
+            raise TypeError("particles must be a skfem_pg.Particles or a "
+                            "scikit-fem mesh, got {}"
                             .format(type(particles).__name__))
         if method not in METHODS:
             raise NotImplementedError(
@@ -100,10 +132,19 @@ class FamilyBasis(AbstractBasis):
         if shape not in GRADIENTS:
             raise ValueError("unknown shape functions {!r}; available: {}"
                              .format(shape, ", ".join(GRADIENTS)))
-        if bond is None:
+        ppg = method != "PBG"
+        if bond is None:  # PPG too: without it VC PPG1 is unstable
             bond = shape == "MTE1"
         if vc == "auto":
-            vc = ("V5" if bond else "V3") if shape == "MTE1" else None
+            vc = ("V5" if bond and not ppg else "V3") if shape == "MTE1" \
+                else None
+        if ppg and vc not in (None, "V3"):
+            raise ValueError("PPG corrects its test derivatives at the "
+                             "masters: vc='V3' or None, got {!r}".format(vc))
+        if method == "PPG2" and vc is not None:
+            raise NotImplementedError(
+                "the VC correction of PPG2 (constraint (5.17)) is not "
+                "implemented yet: use method='PPG1' or vc=None")
         if vc == "V5" and not bond:
             raise ValueError("vc='V5' keeps the bond mapping and needs "
                              "bond=True; use vc='V3' without bond correction")
@@ -124,6 +165,8 @@ class FamilyBasis(AbstractBasis):
             families = (families_mod.from_mesh(particles)
                         if particles.mesh is not None
                         else families_mod.horizon(particles))
+        if ppg:
+            families = petrov.pairwise(families)
         self.families = families
         self._check_families()
         self.timings["families"] = time.perf_counter() - t0
@@ -138,8 +181,14 @@ class FamilyBasis(AbstractBasis):
 
         mem, mask = families.padded()
         Vm = V[mem] * mask
-        self.dx = V[families.masters][:, None] * Vm / Vm.sum(axis=1,
-                                                              keepdims=True)
+        if ppg:
+            self.dx = Vm
+            Gt = np.zeros_like(G)  # test derivatives at the masters
+            Gt[:, 0] = G[:, 0]
+            dx_t = np.zeros_like(Vm)
+            dx_t[:, 0] = V[families.masters]
+        else:
+            self.dx = pbg_weights(V, families)
         self.vc_report = None
         if vc is not None:
             t0 = time.perf_counter()
@@ -151,11 +200,17 @@ class FamilyBasis(AbstractBasis):
                                  .format(x.shape, area_vectors.shape))
             phi = mls1_master_values(x, V, families, n=weight_exponent)
             phi[:, 0] -= 1.0
-            G, self.vc_report = vc_correction(
-                G, self.dx, x, V, families, area_vectors, phi * mask,
-                variant=vc, solver=vc_solver)
+            if ppg:  # (5.16) is (5.18) with the master weights only
+                Gt, self.vc_report = vc_correction(
+                    Gt, dx_t, x, V, families, area_vectors, phi * mask,
+                    variant=vc, solver=vc_solver)
+            else:
+                G, self.vc_report = vc_correction(
+                    G, self.dx, x, V, families, area_vectors, phi * mask,
+                    variant=vc, solver=vc_solver)
             self.timings["vc"] = time.perf_counter() - t0
         self.G = G
+        self.test = None
 
         # --- what scikit-fem's assembly reads ---------------------------
         self.ncomp = dim
@@ -180,6 +235,9 @@ class FamilyBasis(AbstractBasis):
         self.W = np.ones(m)
         self._basis = None
         self._pattern = None
+        if ppg:
+            self.test = copy.copy(self)
+            self.test.G = petrov.test_gradients(Gt[:, 0], families, method)
 
     # ------------------------------------------------------------------
     def _check_families(self):

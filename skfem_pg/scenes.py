@@ -51,9 +51,12 @@ FE_METHODS = {
 }
 
 
-#: Gauss rules of the multilinear/multiquadratic elements: 2 and 3 points
-#: per direction (scikit-fem's defaults use 3 and 7); simplices: defaults
-INTORDER = {"Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2, "Q2": 4, "H2": 4}
+#: Gauss rules: 2 and 3 points per direction for the multilinear and
+#: multiquadratic elements (scikit-fem's defaults use 3 and 7); one point
+#: for T1/O1, whose F is constant per element (exact; the default rule
+#: took 4x the points); T2/O2: scikit-fem's defaults
+INTORDER = {"T1": 1, "O1": 1, "Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2,
+            "Q2": 4, "H2": 4}
 
 
 @dataclass
@@ -156,10 +159,12 @@ class Scene:
         ).assemble(fb)
 
     # -- solving -------------------------------------------------------
-    def solve(self, method="PG", mesh=None, verbose=False, solver="auto",
+    def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
               tangent="consistent", **basis_kwargs):
-        """Solve with ``"PG"`` (``basis_kwargs`` go to ``FamilyBasis``) or
-        an FE method of :data:`FE_METHODS`; returns a :class:`Result`."""
+        """Solve with ``"PG"`` (``basis_kwargs`` go to ``FamilyBasis``,
+        e.g. ``method="PPG1"``) or an FE method of :data:`FE_METHODS`;
+        returns a :class:`Result`."""
+        method = scheme
         t0 = time.perf_counter()
         if method == "PG":
             mesh = self.mesh if mesh is None else mesh

@@ -86,8 +86,12 @@ def test_points_without_mesh_need_area_vectors_for_vc():
 
 def test_bad_options_are_named():
     p = pg.Particles.from_mesh(square(3))
-    with pytest.raises(NotImplementedError, match="PPG1"):
-        pg.FamilyBasis(p, method="PPG1")
+    with pytest.raises(NotImplementedError, match="PPG3"):
+        pg.FamilyBasis(p, method="PPG3")
+    with pytest.raises(NotImplementedError, match="PPG2"):
+        pg.FamilyBasis(p, method="PPG2")  # VC of PPG2: not yet
+    with pytest.raises(ValueError, match="V3"):
+        pg.FamilyBasis(p, method="PPG1", vc="V5")
     with pytest.raises(ValueError, match="MTE2"):
         pg.FamilyBasis(p, shape="MTE2")
     with pytest.raises(ValueError, match="bond=True"):

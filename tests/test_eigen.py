@@ -42,3 +42,28 @@ def test_u1_has_spurious_soft_modes(block):
     rel3 = spectrum(mesh, form, pg.families.horizon(p, factor=3.01),
                     shape="WTE1")
     assert np.sum(rel3[3:] < 0.5 * q1_lowest) >= 5
+
+
+def test_spectrum_tool_and_ppg_stability(block):
+    """Free-block spectra with :mod:`skfem_pg.spectrum` (lumped mass):
+    default VC PPG Unl (with bond correction) is stable like VC PBG Unl;
+    without bond correction its non-symmetric tangent has eigenvalues with
+    negative real part (measured: 6, the lowest -18.9)."""
+    from skfem_pg.spectrum import classify, free_modes
+    mesh, form, _ = block
+    p = pg.Particles.from_mesh(mesh)
+    M = np.repeat(p.volumes, 2)
+    q1 = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()), intorder=2)
+    ref = free_modes(pg.assemble(form, q1), M)["eigenvalues"][3]
+    out = {}
+    for name, kw in {"PBG": {}, "PPG": dict(method="PPG1"),
+                     "PPG no BC": dict(method="PPG1", bond=False),
+                     "U1": dict(shape="WTE1")}.items():
+        s = free_modes(pg.assemble(form, pg.FamilyBasis(p, dim=2, **kw)), M)
+        out[name] = (s["eigenvalues"], classify(s["eigenvalues"], s["scale"],
+                                                3, ref))
+    for name in ("PBG", "PPG"):
+        lam, c = out[name]
+        assert c["zero"] == 3 and c["soft"] == 0 and lam[0] > -1e-10
+    assert out["U1"][1]["soft"] >= 5
+    assert np.sum(out["PPG no BC"][0] < -1e-8) >= 1

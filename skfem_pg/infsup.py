@@ -1,0 +1,102 @@
+r"""Numerical inf-sup test (Chapelle & Bathe 1993; thesis 7.2.5, (7.10)–(7.15);
+seed 003, (3.52)–(3.60)).
+
+For the displacement space :math:`U_h` and the pressure space :math:`P_h` a
+formulation induces, the inf-sup value is :math:`\tilde\beta =
+\sqrt{\lambda_k}`, :math:`\lambda_k` the smallest non-zero eigenvalue of
+
+.. math:: T_h U = \lambda\, S_h U ,                                  \qquad (7.11)
+
+:math:`S_h` the :math:`H^1` seminorm matrix (:math:`\int\nabla u:\nabla v`,
+(7.12)) and :math:`T_h` the pressure projection of the divergence (7.13):
+the tangent with bulk modulus 1 and shear modulus 0 —
+:math:`\int \mathrm{div}\,u\,\mathrm{div}\,v` for displacement formulations
+(pressure at every quadrature point), :math:`B^T M_p^{-1} B` for a discrete
+pressure space (:math:`B = \int q\,\mathrm{div}\,u`,
+:math:`M_p = \int p\,q`; Q1P0, MINI ...).
+With ``k - 1`` zero eigenvalues, the number of spurious pressure modes is
+
+.. math:: k_{pm} = k - (n_u - n_p + 1).                              \qquad (7.15)
+
+A formulation passes when :math:`\tilde\beta` stays bounded under refinement
+and :math:`k_{pm} = 0`; a decreasing :math:`\tilde\beta` predicts locking.
+The same functions accept scikit-fem bases and family bases.
+"""
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import skfem as fem
+from skfem.helpers import ddot, div, grad
+
+from .assembly import assemble
+
+
+@fem.BilinearForm
+def div_div(u, v, w):
+    r""":math:`\int \mathrm{div}\,u\;\mathrm{div}\,v` (K = 1, μ = 0)."""
+    return div(u) * div(v)
+
+
+@fem.BilinearForm
+def grad_grad(u, v, w):
+    r""":math:`\int \nabla u : \nabla v` (the :math:`H^1` seminorm)."""
+    return ddot(grad(u), grad(v))
+
+
+def infsup(T, S, free, n_pressure, zero_tol=1e-8):
+    """Solve (7.11) on the ``free`` dofs (dense; for the small model
+    problems of the test) and return a dict with ``beta`` (7.14), the
+    number of zero eigenvalues ``zeros`` (``k - 1``), the spurious pressure
+    modes ``kpm`` (7.15) and the ``eigenvalues``.  Eigenvalues below
+    ``zero_tol`` times the largest count as zero."""
+    T = sp.csr_matrix(T)[free][:, free].toarray()
+    S = sp.csr_matrix(S)[free][:, free].toarray()
+    lam = sla.eigh(0.5 * (T + T.T), 0.5 * (S + S.T), eigvals_only=True)
+    zero = lam < zero_tol * lam.max()
+    k = int(zero.sum()) + 1
+    n_u = len(free)
+    return {"beta": float(np.sqrt(lam[~zero].min())), "zeros": k - 1,
+            "kpm": k - (n_u - n_pressure + 1), "n_u": n_u,
+            "n_p": int(n_pressure), "eigenvalues": lam}
+
+
+@fem.BilinearForm
+def pressure_divergence(u, q, w):
+    r""":math:`\int q\,\mathrm{div}\,u`."""
+    return q * div(u)
+
+
+@fem.BilinearForm
+def pressure_mass(p, q, w):
+    r""":math:`\int p\,q`."""
+    return p * q
+
+
+def infsup_fe(basis, free, pbasis=None, **kw):
+    """Inf-sup test of a scikit-fem vector basis: displacement-based
+    (pressure at the quadrature points) or, with a pressure basis
+    ``pbasis`` on the same mesh and quadrature (e.g. ``ElementQuad0`` for
+    Q1P0, ``ElementTriP1`` with ``ElementTriMini`` displacements),
+    :math:`T = B^T M_p^{-1} B`."""
+    S = assemble(grad_grad, basis)
+    if pbasis is None:
+        return infsup(assemble(div_div, basis), S, free, basis.dx.size,
+                      **kw)
+    B = pressure_divergence.assemble(basis, pbasis).toarray()
+    Mp = pressure_mass.assemble(pbasis).toarray()
+    T = B.T @ np.linalg.solve(Mp, B)
+    return infsup(T, S, free, pbasis.N, **kw)
+
+
+def infsup_pg(basis, free, **kw):
+    """Inf-sup test of a PBG family basis (displacement formulation):
+    pressure at every member of every family (Unl), or one per family when
+    the gradient is constant in the family (WTE1: U1)."""
+    if basis.test is not None:
+        raise ValueError("the inf-sup test needs a symmetric (PBG) family "
+                         "basis, got {}".format(basis.method))
+    T = assemble(div_div, basis)
+    S = assemble(grad_grad, basis)
+    n_p = len(basis.families) if basis.shape == "WTE1" \
+        else int(basis.families.sizes.sum())
+    return infsup(T, S, free, n_p, **kw)

@@ -1,0 +1,111 @@
+r"""Peridynamic Petrov–Galerkin (PPG) test bases, thesis (4.21)–(4.22).
+
+PPG evaluates the test-shape derivatives once per family, at the master:
+:math:`G_t^{kki}` (here the WTE1 derivative at the master, which MTE1
+shares).  Written over bonds (formulas.md section 2),
+
+.. math::
+
+    \text{PPG1:}\quad \delta W = \sum_k V^k \sum_{j\in H^k}
+        P(F^{jk}) : \big((\delta u^j - \delta u^k)\otimes G_t^{kkj}\big),
+
+with :math:`F^{jk}` the trial deformation gradient at :math:`X^k` computed
+in family :math:`j`.  As an element: family ``f``, quadrature point
+``k ∈ H^f`` with weight :math:`V^k`, trial derivatives :math:`G^{fki}`, and
+test derivatives
+
+.. math::
+
+    T^{fk f} = G_t^{kkf}, \qquad T^{fkk} = -G_t^{kkf}, \qquad
+    T^{fki} = 0 \text{ otherwise};
+
+PPG2 (4.22) swaps the roles, :math:`G_t^{kkf} \to -G_t^{ffk}`.  Families
+must be pairwise (``k ∈ H^f`` exactly when ``f ∈ H^k``): :func:`pairwise`
+completes them.
+
+Integration constraint of PPG1 (5.16): for every particle ``i``
+
+.. math:: \sum_{j\in H^i} V^j G_t^{jji} = A^i ,
+
+the PBG constraint with the weights :math:`w_{kj}` of the master only, so
+the VC correction of :mod:`~skfem_pg.corrections` (V3, one
+:math:`\alpha^k` per family) applies unchanged.  PPG matrices are not
+symmetric.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from .families import Families
+
+
+def pairwise(fam):
+    """Families completed to pairwise ones: ``j`` joins :math:`H^k`
+    whenever ``k`` is in :math:`H^j` (formulas.md section 1 (c))."""
+    A = fam.adjacency().astype(float)
+    masters = fam.masters
+    if len(masters) != fam.n_particles:
+        keep = np.zeros(fam.n_particles)
+        keep[masters] = 1.0
+        A = sp.diags(keep) @ A @ sp.diags(keep)
+    S = A + A.T
+    if S.nnz == A.nnz:
+        return fam
+    return Families.from_adjacency(S, masters)
+
+
+def reverse_slots(fam):
+    """``rev[f, q]``: the slot of master ``f`` in the family of its member
+    ``mem[f, q]``; -1 in padded slots.  Needs pairwise families."""
+    mem, mask = fam.padded()
+    nf, m = mem.shape
+    index = np.full(fam.n_particles, -1, dtype=np.int64)
+    index[fam.masters] = np.arange(nf)
+    owner = index[mem]  # family of each member
+    # key (family, particle) -> slot, via sorting
+    keys = index[fam.masters][:, None].astype(np.int64) * fam.n_particles \
+        + mem
+    flat = np.where(mask, keys, -1).ravel()
+    order = np.argsort(flat)
+    wanted = (owner * fam.n_particles
+              + fam.masters[:, None]).ravel()
+    pos = np.searchsorted(flat[order], wanted)
+    pos = np.minimum(pos, len(flat) - 1)
+    found = (flat[order][pos] == wanted) & mask.ravel() & (owner.ravel()
+                                                           >= 0)
+    rev = np.where(found, order[pos] % m, -1).reshape(nf, m)
+    if np.any(mask & (rev < 0)):
+        f, q = np.argwhere(mask & (rev < 0))[0]
+        raise ValueError(
+            "families are not pairwise: particle {} is in the family of "
+            "particle {} but not the other way round; complete them with "
+            "skfem_pg.petrov.pairwise".format(mem[f, q], fam.masters[f]))
+    return rev
+
+
+def quadrature_weights(volumes, fam):
+    """PPG weights ``dx[f, q] = V^{mem[f, q]}`` (0 in padded slots)."""
+    mem, mask = fam.padded()
+    return volumes[mem] * mask
+
+
+def test_gradients(Gt, fam, variant="PPG1"):
+    """Test derivatives ``T[f, q, i]`` (shape ``(nf, m, m, d)``) of the
+    element view from the master derivatives ``Gt[k, i]`` (``(nf, m, d)``:
+    derivative of member ``i`` of family ``k`` at its master)."""
+    mem, mask = fam.padded()
+    nf, m, d = Gt.shape
+    if variant == "PPG1":
+        rev = reverse_slots(fam)
+        index = np.full(fam.n_particles, -1, dtype=np.int64)
+        index[fam.masters] = np.arange(nf)
+        g = Gt[index[mem], np.maximum(rev, 0)] * mask[..., None]  # G_t^{kkf}
+    elif variant == "PPG2":
+        g = -Gt * mask[..., None]  # -G_t^{ffk}
+    else:
+        raise ValueError("variant must be 'PPG1' or 'PPG2'")
+    g[:, 0] = 0.0  # q = master: the two contributions cancel
+    T = np.zeros((nf, m, m, d))
+    T[:, :, 0] = g
+    q = np.arange(m)
+    T[:, q, q] -= g
+    return T
