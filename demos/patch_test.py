@@ -26,10 +26,16 @@ VARIANTS = {
     "BCPBG Unl": dict(shape="MTE1", bond=True, vc=None),
     "VCPBG V3 Unl": dict(shape="MTE1", bond=False, vc="V3"),
     "VCBCPBG V5 Unl": dict(shape="MTE1", bond=True, vc="V5"),
+    "PPG Unl": dict(method="PPG1", bond=False, vc=None),
+    "VCPPG V3 Unl": dict(method="PPG1", bond=False, vc="V3"),
+    "VCBCPPG V3 Unl": dict(method="PPG1", bond=True, vc="V3"),
 }
-#: thesis Table 7.2 (εL2, εH1) on 1345 irregular particles
+#: thesis Table 7.2 (εL2, εH1) on 1345 irregular particles; its VC rows
+#: use the "sn"/"s"/"p" boundary variants, ours the min-norm solution
 THESIS = {"PBG Unl (MTE1)": (8.563e-3, 1.284e-1),
-          "VCBCPBG V5 Unl": (2.518e-14, 1.154e-12)}
+          "VCBCPBG V5 Unl": (2.518e-14, 1.154e-12),
+          "PPG Unl": (9.532e-2, 2.336e-1),
+          "VCPPG V3 Unl": (6.489e-17, 9.974e-16)}
 
 
 def node_sets():

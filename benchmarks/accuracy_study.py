@@ -1,0 +1,121 @@
+"""Accuracy study: the error of PG variants relative to FE on the same nodes
+(issue #3, item 6; thesis 7.2.3, Fig. 7.11).
+
+Manufactured solution of the thesis (7.7)–(7.8) on [-1, 1]², E = 100e3,
+nu = 0.3, full Dirichlet boundary; ±0.3h distorted quad node sets (FE: Q1)
+and the same nodes split into triangles (FE: T1).  For each PG variant:
+relative L2 / H1 errors at the finest node set, their ratio to FE's, the
+least-squares rates, and the setup + assembly + solve time relative to FE's.
+Writes benchmarks/out/accuracy_study.png (L2 error against nodes).
+
+    python benchmarks/accuracy_study.py [--sizes 8 16 32 64]
+"""
+import argparse
+import os
+
+import numpy as np
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg.convergence import PlaneWaves, rates, solve_manufactured
+from skfem_pg.models import lame
+
+OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+FIELD = PlaneWaves.hillman2019()
+LAM, MU = lame(100e3, 0.3)
+
+VARIANTS = {
+    "PBG Unl": dict(vc=None),
+    "VC PBG Unl (V5, default)": dict(),
+    "VC PBG Unl V3, no BC": dict(bond=False, vc="V3"),
+    "VC PBG Unl, n = 2": dict(weight_exponent=2),
+    "VC PBG Unl, δ = 2.01h": "horizon",
+    "VC PPG Unl (BC)": dict(method="PPG1"),
+    "VC PPG Unl, no BC": dict(method="PPG1", bond=False),
+    "PPG Unl": dict(method="PPG1", vc=None),
+}
+
+
+def node_set(n, kind):
+    m = fem.MeshQuad.init_tensor(np.linspace(-1, 1, n + 1),
+                                 np.linspace(-1, 1, n + 1))
+    m = pg.meshing.distort(m, 0.3, seed=n)
+    return m.to_meshtri() if kind == "tri" else m
+
+
+def run(kind, sizes):
+    meshes = [node_set(n, kind) for n in sizes]
+    series = {"FE": [solve_manufactured(m, FIELD, LAM, MU, "FE")
+                     for m in meshes]}
+    for name, kw in VARIANTS.items():
+        rows = []
+        for m in meshes:
+            if kw == "horizon":
+                p = pg.Particles.from_mesh(m)
+                kw_m = dict(families=pg.families.horizon(p, factor=2.01))
+            else:
+                kw_m = kw
+            rows.append(solve_manufactured(m, FIELD, LAM, MU, "PG", **kw_m))
+        series[name] = rows
+    return series
+
+
+def report(kind, series):
+    fe = series["FE"]
+    fe_name = "Q1" if kind == "quad" else "T1"
+    print("\n{} node sets ({} nodes at the finest); FE = {}".format(
+        kind, fe[-1]["nodes"], fe_name))
+    print("{:26s} {:>9s} {:>7s} {:>9s} {:>7s} {:>6s} {:>6s} {:>7s}".format(
+        "variant", "L2", "/FE", "H1", "/FE", "rL2", "rH1", "time/FE"))
+    for name, rows in series.items():
+        h = [r["h"] for r in rows]
+        r2 = rates(h, [r["L2"] for r in rows])[0]
+        r1 = rates(h, [r["H1"] for r in rows])[0]
+        last = rows[-1]
+        print("{:26s} {:9.2e} {:7.2f} {:9.2e} {:7.2f} {:6.2f} {:6.2f} "
+              "{:7.2f}".format(
+                  fe_name if name == "FE" else name, last["L2"],
+                  last["L2"] / fe[-1]["L2"], last["H1"],
+                  last["H1"] / fe[-1]["H1"], r2, r1,
+                  last["seconds"] / fe[-1]["seconds"]))
+
+
+def plot(all_series, fn):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5))
+    for ax, (kind, series) in zip(axes, all_series.items()):
+        for name, rows in series.items():
+            style = "k--o" if name == "FE" else ".-"
+            ax.loglog([r["nodes"] for r in rows], [r["L2"] for r in rows],
+                      style, label=("Q1" if kind == "quad" else "T1")
+                      if name == "FE" else name)
+        ax.set_xlabel("nodes")
+        ax.set_ylabel("relative L2 error")
+        ax.set_title("{} node sets, ±0.3h distorted".format(kind))
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(fn, dpi=120)
+    plt.close(fig)
+
+
+def main(sizes=(8, 16, 32, 64)):
+    print("Manufactured solution (thesis 7.7), full Dirichlet; errors "
+          "relative, rates = least squares over nodes per side {}".format(
+              list(sizes)))
+    all_series = {}
+    for kind in ("quad", "tri"):
+        all_series[kind] = run(kind, sizes)
+        report(kind, all_series[kind])
+    os.makedirs(OUT, exist_ok=True)
+    fn = os.path.join(OUT, "accuracy_study.png")
+    plot(all_series, fn)
+    print("\nwrote", os.path.relpath(fn))
+    return all_series
+
+
+if __name__ == "__main__":
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64])
+    main(ap.parse_args().sizes)
