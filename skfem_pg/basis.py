@@ -68,18 +68,21 @@ class FamilyBasis(AbstractBasis):
     families
         :class:`~skfem_pg.families.Families`; default: mesh connectivity
         (``families.from_mesh``) for mesh particles, otherwise a horizon of
-        1.51 h.
+        1.51 h; for WTE2 a horizon of 2.51 h, small families enlarged to
+        one member more than the quadratic basis needs.
     shape
-        ``"MTE1"`` (moving Taylor expansion, formulation Unl; default) or
+        ``"MTE1"`` (moving Taylor expansion, formulation Unl; default),
         ``"WTE1"`` (static Taylor expansion = classical correspondence,
-        formulation U1).
+        formulation U1) or ``"WTE2"`` (second-order static Taylor
+        expansion, formulation U2; needs 5 (2-D) / 9 (3-D) non-master
+        members, e.g. a 2.51 h horizon).
     bond
         Bond correction (5.55).  Default: on for MTE1 (PBG and PPG:
         VC PPG1 without it has negative eigenvalues on the free block,
         ``tests/test_eigen.py``), off for WTE1.
     vc
         Variationally consistent correction: ``"V5"`` (default with bond
-        correction), ``"V3"`` (default for MTE1 without bond correction,
+        correction), ``"V3"`` (default for MTE1 without bond correction and for WTE2,
         and the only one for PPG, applied to its test derivatives) or
         ``None`` (default for WTE1: the classical, uncorrected method).
     method
@@ -135,9 +138,12 @@ class FamilyBasis(AbstractBasis):
         ppg = method != "PBG"
         if bond is None:  # PPG too: without it VC PPG1 is unstable
             bond = shape == "MTE1"
+        if bond and shape == "WTE2":
+            raise ValueError("the bond correction (5.55) is for linear "
+                             "bases; use bond=False with shape='WTE2'")
         if vc == "auto":
-            vc = ("V5" if bond and not ppg else "V3") if shape == "MTE1" \
-                else None
+            vc = {"MTE1": "V5" if bond and not ppg else "V3",
+                  "WTE2": "V3"}.get(shape)
         if ppg and vc not in (None, "V3"):
             raise ValueError("PPG corrects its test derivatives at the "
                              "masters: vc='V3' or None, got {!r}".format(vc))
@@ -161,7 +167,11 @@ class FamilyBasis(AbstractBasis):
         sdim = particles.dim
 
         t0 = time.perf_counter()
-        if families is None:
+        if families is None and shape == "WTE2":
+            d = particles.dim
+            families = families_mod.horizon(
+                particles, factor=2.51, min_size=2 + d + d * (d + 1) // 2)
+        elif families is None:
             families = (families_mod.from_mesh(particles)
                         if particles.mesh is not None
                         else families_mod.horizon(particles))
@@ -250,9 +260,12 @@ class FamilyBasis(AbstractBasis):
             q = fam.members[np.nonzero(inactive)[0][0]]
             raise FamilyError("{} has zero volume but is a family member"
                               .format(describe_particle(q, p.x[:, q])))
-        # linear Taylor expansions need d others; MLS1 at the master
-        # (VC correction) needs d + 1 others
-        need = p.dim + 2 if self.vc is not None else p.dim + 1
+        # linear Taylor expansions need d others, WTE2 d + d(d+1)/2; MLS1
+        # at the master (VC correction) needs d + 1 others
+        d = p.dim
+        need = d + 2 if self.vc is not None else d + 1
+        if self.shape == "WTE2":
+            need = max(need, 1 + d + d * (d + 1) // 2)
         families_mod.check_supports(p, fam, need, "{}{}".format(
             self.shape, " with VC correction" if self.vc else ""))
 

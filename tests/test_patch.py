@@ -71,3 +71,16 @@ def test_vc_solvers_give_the_same_min_norm_correction(mesh):
         G[solver] = r["basis"].G
     assert np.abs(G["direct"] - G["lsqr"]).max() <= \
         1e-9 * np.abs(G["direct"]).max()
+
+
+@pytest.mark.parametrize("name", ["distorted quads", "distorted hexes"])
+@pytest.mark.parametrize("method", ["PBG", "PPG1"])
+def test_vc_u2_passes_uncorrected_fails(name, method):
+    mesh = {**MESHES_2D, **MESHES_3D}[name]()
+    r = linear_patch_test(mesh, TOP[mesh.dim()], shape="WTE2", method=method)
+    assert r["max_error"] <= 1e-10
+    r0 = linear_patch_test(mesh, TOP[mesh.dim()], shape="WTE2", vc=None,
+                           method=method)
+    assert r0["max_error"] > 1e-3
+    with pytest.raises(ValueError, match="linear bases"):
+        pg.FamilyBasis(mesh, dim=mesh.dim(), shape="WTE2", bond=True)
