@@ -1,5 +1,5 @@
-r"""Verification tools (thesis chapter 7): discrete error norms and the
-linear patch test.
+r"""Verification tools (thesis chapter 7): discrete error norms, the linear
+and the quadratic patch test.
 
 Discrete norms (7.3), with particle volumes and family weights as
 quadrature:
@@ -80,6 +80,66 @@ def linear_patch_test(mesh, neumann, gradient=None, E=100.0, nu=0.3,
         "L2": l2_error(basis, u, lambda x: gradient @ x),
         "H1": h1_error(basis, u, lambda x: gradient.reshape(
             d, d, *([1] * (x.ndim - 1)))),
+        "basis": basis,
+        "u": u,
+    }
+
+
+#: quadratic patch-test field (7.4): u_a = L[a]·X + X·Q[a]·X
+QUADRATIC_PATCH_L = np.array([[0.12, 0.14], [0.11, 0.13]])
+QUADRATIC_PATCH_Q = np.array([[[0.16, 0.09], [0.09, 0.2]],
+                              [[0.15, 0.05], [0.05, 0.21]]])
+
+
+def quadratic_patch_test(mesh, neumann, E=100.0, nu=0.3, **basis_kwargs):
+    r"""Quadratic patch test (thesis (7.4)–(7.6)) on a 2-D ``mesh``:
+    :math:`u = L X + X^T Q X`, linear stress, the constant body force
+    :math:`-\mathrm{Div}\,P` as nodal forces :math:`b V^i`, Dirichlet on
+    all boundary facets but ``neumann``, where the FE-consistent traction
+    load :math:`\int_\Gamma N_i P(x) n` is applied.  Returns a dict like
+    :func:`linear_patch_test`."""
+    if mesh.dim() != 2:
+        raise ValueError("the quadratic patch test (7.4) is 2-D")
+    lam, mu = lame(E, nu)
+    L, Q = QUADRATIC_PATCH_L, QUADRATIC_PATCH_Q
+
+    def u_exact(x):
+        return np.einsum("ab,b...->a...", L, x) + np.einsum(
+            "abc,b...,c...->a...", Q, x, x)
+
+    def grad_exact(x):
+        return L.reshape(2, 2, *([1] * (x.ndim - 1))) + 2 * np.einsum(
+            "abc,c...->ab...", Q, x)
+
+    def stress(x):
+        g = grad_exact(x)
+        eps = 0.5 * (g + np.swapaxes(g, 0, 1))
+        tr = eps[0, 0] + eps[1, 1]
+        return 2 * mu * eps + lam * tr * np.eye(2).reshape(
+            2, 2, *([1] * (np.ndim(tr))))
+
+    # b = -Div P = -(mu Δu + (lam + mu) grad div u), constant (7.6)
+    lap = 2 * np.trace(Q, axis1=1, axis2=2)
+    graddiv = 2 * np.einsum("bab->a", Q)
+    b = -(mu * lap + (lam + mu) * graddiv)
+    particles = Particles.from_mesh(mesh)
+    basis = FamilyBasis(particles, dim=2, **basis_kwargs)
+    K = assemble(linear_elasticity(lam, mu), basis)
+    nf = mesh.normalize_facets(neumann)
+    fb = fem.FacetBasis(mesh, fem.ElementVector(type(mesh).elem()),
+                        facets=nf, intorder=4)
+    f = fem.LinearForm(lambda v, w: sum(
+        (stress(w.x)[a] * w.n).sum(axis=0) * v[a] for a in range(2))
+    ).assemble(fb)
+    f = f + np.repeat(particles.volumes, 2) * np.tile(b, particles.n)
+    dirichlet = np.setdiff1d(mesh.boundary_facets(), nf)
+    D = basis.get_dofs(dirichlet)
+    uex = u_exact(particles.x).T.ravel()
+    u = fem.solve(*fem.condense(K, f, x=uex, D=D))
+    return {
+        "max_error": float(np.abs(u - uex).max()),
+        "L2": l2_error(basis, u, u_exact),
+        "H1": h1_error(basis, u, grad_exact),
         "basis": basis,
         "u": u,
     }

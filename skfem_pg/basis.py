@@ -43,6 +43,8 @@ from .corrections import bond_correction, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS, mls1_master_values
+from .shape.least_squares import wls2_master_values
+from .vc2 import vc2_correction
 
 METHODS = ("PBG", "PPG1", "PPG2")
 
@@ -84,7 +86,10 @@ class FamilyBasis(AbstractBasis):
         Variationally consistent correction: ``"V5"`` (default with bond
         correction), ``"V3"`` (default for MTE1 without bond correction and for WTE2,
         and the only one for PPG, applied to its test derivatives) or
-        ``None`` (default for WTE1: the classical, uncorrected method).
+        ``None`` (default for WTE1: the classical, uncorrected method), or
+        ``"VC2"`` (second-order VC with V4 correction functions, for
+        ``shape="WTE2"``: passes the quadratic patch test;
+        :mod:`skfem_pg.vc2`).
     method
         ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
         ``"PPG1"`` or ``"PPG2"`` (Peridynamic Petrov–Galerkin (4.21),
@@ -101,6 +106,12 @@ class FamilyBasis(AbstractBasis):
     area_vectors
         ``(dim, np)`` surface area vectors :math:`A^i`; default: the
         FE-consistent ones of ``particles.area_vectors()``.
+    vc_exclude
+        VC2 only: particles whose integration constraints are not enforced
+        — those with Dirichlet conditions, whose equations are eliminated.
+        The full second-order system is incompatible (its quadratic left
+        null vectors meet the interpolation error of the surface term), so
+        VC2 passes the quadratic patch test only with them excluded.
 
     Attributes
     ----------
@@ -121,7 +132,7 @@ class FamilyBasis(AbstractBasis):
 
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
-                 vc_solver="auto", area_vectors=None):
+                 vc_solver="auto", area_vectors=None, vc_exclude=None):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -144,6 +155,10 @@ class FamilyBasis(AbstractBasis):
         if vc == "auto":
             vc = {"MTE1": "V5" if bond and not ppg else "V3",
                   "WTE2": "V3"}.get(shape)
+        if vc == "VC2" and (shape != "WTE2" or ppg):
+            raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
+                             "trial basis of PBG: shape='WTE2', "
+                             "method='PBG'")
         if ppg and vc not in (None, "V3"):
             raise ValueError("PPG corrects its test derivatives at the "
                              "masters: vc='V3' or None, got {!r}".format(vc))
@@ -208,9 +223,17 @@ class FamilyBasis(AbstractBasis):
             if area_vectors.shape != x.shape:
                 raise ValueError("area_vectors must have shape {}, got {}"
                                  .format(x.shape, area_vectors.shape))
-            phi = mls1_master_values(x, V, families, n=weight_exponent)
+            if vc == "VC2":
+                phi = wls2_master_values(x, V, families, n=weight_exponent)
+            else:
+                phi = mls1_master_values(x, V, families, n=weight_exponent)
             phi[:, 0] -= 1.0
-            if ppg:  # (5.16) is (5.18) with the master weights only
+            if vc == "VC2":
+                G, self.vc_report = vc2_correction(
+                    G, self.dx, x, V, families, area_vectors,
+                    particles.area_moments(), phi * mask,
+                    exclude=vc_exclude)
+            elif ppg:  # (5.16) is (5.18) with the master weights only
                 Gt, self.vc_report = vc_correction(
                     Gt, dx_t, x, V, families, area_vectors, phi * mask,
                     variant=vc, solver=vc_solver)
@@ -264,8 +287,9 @@ class FamilyBasis(AbstractBasis):
         # at the master (VC correction) needs d + 1 others
         d = p.dim
         need = d + 2 if self.vc is not None else d + 1
-        if self.shape == "WTE2":
-            need = max(need, 1 + d + d * (d + 1) // 2)
+        if self.shape == "WTE2":  # + WLS2 with a constant term for VC2
+            need = max(need, 1 + d + d * (d + 1) // 2
+                       + (self.vc == "VC2"))
         families_mod.check_supports(p, fam, need, "{}{}".format(
             self.shape, " with VC correction" if self.vc else ""))
 

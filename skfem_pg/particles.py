@@ -266,6 +266,30 @@ class Particles:
             self._area_vectors = out
         return out
 
+    def area_moments(self, origin=None, facets=None):
+        r"""FE-consistent first moments of the area vectors, shape
+        ``(dim, dim, n)``:
+
+        .. math:: A_2^{i}{}_{cB} = \int_\Gamma N_i\,(x - x_0)_c\, n_B
+                  \,d\Gamma ,
+
+        ``x_0 = origin`` (default 0): the boundary term of the second-order
+        integration constraint (VC2, (5.26)).  Vertex particles only."""
+        self._need_mesh("area moments")
+        if self.kind != "vertices":
+            raise NotImplementedError("area moments need vertex particles")
+        x0 = np.zeros(self.dim) if origin is None else np.asarray(origin)
+        fb = self._facet_basis(facets)
+        out = np.zeros((self.dim, self.dim, fb.N))
+        for c in range(self.dim):
+            for b in range(self.dim):
+                out[c, b] = fem.LinearForm(
+                    lambda v, w: v * (w.x[c] - x0[c]) * w.n[b]).assemble(fb)
+        on = np.zeros(fb.N, dtype=bool)
+        on[self.mesh.facets[:, fb.find].ravel()] = True
+        out[..., ~on] = 0.0
+        return out
+
     def _mls_area_vectors(self, facets=None):
         from .shape import mls1_values
         e1, _ = linear_elements(self.mesh)

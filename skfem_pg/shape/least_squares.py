@@ -50,3 +50,32 @@ def mls1_master_values(x, volumes, fam, n=1):
                            "besides the master in general position)"
                            .format(d + 1))
     return N
+
+
+def wls2_master_values(x, volumes, fam, n=1):
+    r""":math:`N_{WLS2}^{kki}` (quadratic basis with constant term, master
+    weight excluded), shape ``(nf, m)``: they reproduce quadratic fields at
+    the master, so :math:`\varphi^{ki} = N^{kki} - \delta_{ki}` (correction
+    function V4) is orthogonal to all quadratics.  Needs ``d + d(d+1)/2 + 1``
+    non-master members in general position."""
+    from .quadratic import taylor2_basis
+    mem_all, mask_all = fam.padded()
+    nf, m = mem_all.shape
+    d = x.shape[0]
+    N = np.zeros((nf, m))
+    for sl in chunks(nf, m * m):
+        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
+        D = geo.D0
+        W = weights((D ** 2).sum(-1), n) * geo.V
+        p = np.concatenate([np.ones(D.shape[:-1] + (1,)), taylor2_basis(D)],
+                           axis=-1)
+        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
+        Minv, singular = inverse_spd(M)
+        if np.any(singular):
+            k = np.nonzero(singular)[0][0]
+            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
+                           None, "WLS2 (master excluded, needs {} members "
+                           "besides the master in general position)"
+                           .format(1 + d + d * (d + 1) // 2))
+        N[sl] = W * (p @ Minv[..., :, :1])[..., 0]
+    return N
