@@ -39,11 +39,10 @@ from skfem.element import DiscreteField
 
 from . import families as families_mod
 from . import petrov
-from .corrections import bond_correction, vc_correction
+from .corrections import bond_correction, correction_functions, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
-from .shape import GRADIENTS, mls1_master_values
-from .shape.least_squares import wls2_master_values
+from .shape import GRADIENTS
 from .vc2 import vc2_correction
 
 METHODS = ("PBG", "PPG1", "PPG2")
@@ -83,10 +82,12 @@ class FamilyBasis(AbstractBasis):
         VC PPG1 without it has negative eigenvalues on the free block,
         ``tests/test_eigen.py``), off for WTE1.
     vc
-        Variationally consistent correction: ``"V5"`` (default with bond
-        correction), ``"V3"`` (default for MTE1 without bond correction and for WTE2,
-        and the only one for PPG, applied to its test derivatives) or
-        ``None`` (default for WTE1: the classical, uncorrected method), or
+        Variationally consistent correction (:func:`~skfem_pg.corrections.
+        correction_functions`): ``"V5"`` (default with bond correction),
+        ``"V3"`` (default for MTE1 without bond correction, for WTE2 and
+        for PPG, whose test derivatives it corrects), ``"V4"`` (keeps
+        quadratic consistency), ``"V1"`` (PPG only), ``None`` (default for
+        WTE1: the classical, uncorrected method), or
         ``"VC2"`` (second-order VC with V4 correction functions, for
         ``shape="WTE2"``: passes the quadratic patch test;
         :mod:`skfem_pg.vc2`).
@@ -107,11 +108,12 @@ class FamilyBasis(AbstractBasis):
         ``(dim, np)`` surface area vectors :math:`A^i`; default: the
         FE-consistent ones of ``particles.area_vectors()``.
     vc_exclude
-        VC2 only: particles whose integration constraints are not enforced
-        — those with Dirichlet conditions, whose equations are eliminated.
-        The full second-order system is incompatible (its quadratic left
-        null vectors meet the interpolation error of the surface term), so
-        VC2 passes the quadratic patch test only with them excluded.
+        Particles whose integration constraints are not enforced — those
+        with Dirichlet conditions, whose equations are eliminated.  The
+        full V4 and VC2 systems are incompatible (their quadratic left null
+        vectors meet the interpolation error of the surface term), so they
+        reach round-off only with these excluded; VC2 then passes the
+        quadratic patch test.  Uses the LSQR solve.
 
     Attributes
     ----------
@@ -159,9 +161,10 @@ class FamilyBasis(AbstractBasis):
             raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
                              "trial basis of PBG: shape='WTE2', "
                              "method='PBG'")
-        if ppg and vc not in (None, "V3"):
-            raise ValueError("PPG corrects its test derivatives at the "
-                             "masters: vc='V3' or None, got {!r}".format(vc))
+        allowed = ("V1", "V3", "V4") if ppg else ("V3", "V4", "V5", "VC2")
+        if vc is not None and vc not in allowed:
+            raise ValueError("vc={!r} is not available for {}: use one of {} "
+                             "or None".format(vc, method, ", ".join(allowed)))
         if method == "PPG2" and vc is not None:
             raise NotImplementedError(
                 "the VC correction of PPG2 (constraint (5.17)) is not "
@@ -223,24 +226,20 @@ class FamilyBasis(AbstractBasis):
             if area_vectors.shape != x.shape:
                 raise ValueError("area_vectors must have shape {}, got {}"
                                  .format(x.shape, area_vectors.shape))
-            if vc == "VC2":
-                phi = wls2_master_values(x, V, families, n=weight_exponent)
-            else:
-                phi = mls1_master_values(x, V, families, n=weight_exponent)
-            phi[:, 0] -= 1.0
+            phi = correction_functions(vc, x, V, families,
+                                       n=weight_exponent)
             if vc == "VC2":
                 G, self.vc_report = vc2_correction(
                     G, self.dx, x, V, families, area_vectors,
-                    particles.area_moments(), phi * mask,
-                    exclude=vc_exclude)
+                    particles.area_moments(), phi, exclude=vc_exclude)
             elif ppg:  # (5.16) is (5.18) with the master weights only
                 Gt, self.vc_report = vc_correction(
-                    Gt, dx_t, x, V, families, area_vectors, phi * mask,
-                    variant=vc, solver=vc_solver)
+                    Gt, dx_t, x, V, families, area_vectors, phi,
+                    variant=vc, solver=vc_solver, exclude=vc_exclude)
             else:
                 G, self.vc_report = vc_correction(
-                    G, self.dx, x, V, families, area_vectors, phi * mask,
-                    variant=vc, solver=vc_solver)
+                    G, self.dx, x, V, families, area_vectors, phi,
+                    variant=vc, solver=vc_solver, exclude=vc_exclude)
             self.timings["vc"] = time.perf_counter() - t0
         self.G = G
         self.test = None
@@ -287,9 +286,11 @@ class FamilyBasis(AbstractBasis):
         # at the master (VC correction) needs d + 1 others
         d = p.dim
         need = d + 2 if self.vc is not None else d + 1
-        if self.shape == "WTE2":  # + WLS2 with a constant term for VC2
-            need = max(need, 1 + d + d * (d + 1) // 2
-                       + (self.vc == "VC2"))
+        q = d + d * (d + 1) // 2  # quadratic basis without constant
+        if self.shape == "WTE2":
+            need = max(need, 1 + q)
+        if self.vc in ("V4", "VC2"):  # WLS2 with a constant term
+            need = max(need, 2 + q)
         families_mod.check_supports(p, fam, need, "{}{}".format(
             self.shape, " with VC correction" if self.vc else ""))
 

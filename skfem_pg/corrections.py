@@ -242,7 +242,7 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2):
 
 
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
-                  solver="auto", tol=1e-14, maxiter=None):
+                  solver="auto", tol=1e-14, maxiter=None, exclude=None):
     """Correct ``G`` so the PBG integration constraint holds.
 
     Parameters
@@ -259,23 +259,31 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         ``(d, np)`` area vectors :math:`A^i`.
     phi
         ``(nf, m)`` correction function values
-        :math:`N^{kki}_{MLS1} - \\delta_{ki}`.
+        (:func:`correction_functions`).
     variant
-        ``"V5"`` (with bond projector, keeps the bond mapping) or ``"V3"``.
+        ``"V5"`` (with bond projector, keeps the bond mapping), ``"V3"``,
+        ``"V4"`` or ``"V1"`` (no projector).
     solver
         ``"direct"`` (one scalar sparse LU of the pinned system; the
         default, ``"auto"``) or ``"lsqr"`` (scipy LSQR; a reference, its
-        iteration count grows with the node count).
+        iteration count grows with the node count).  V1 and V4, and any
+        ``exclude``, take LSQR: their systems lack the structure the
+        direct solve relies on (V4's left null space holds the quadratic
+        fields and is incompatible with the surface terms, V1 does not
+        keep the linear fields in it).
+    exclude
+        Particles whose constraints are not enforced (Dirichlet particles,
+        whose equations are eliminated); needed by V4 for round-off
+        patch tests.
 
     Returns
     -------
     G_corrected, VCReport
 
     """
-    if variant not in ("V3", "V5"):
-        raise ValueError("VC variant {!r} is not available yet (V3, V5); "
-                         "V1, V2, V4 come with the correction catalogue"
-                         .format(variant))
+    if variant not in ("V1", "V3", "V4", "V5"):
+        raise ValueError("VC variant {!r} is not available (V1, V3, V4, "
+                         "V5; second order: skfem_pg.vc2)".format(variant))
     mem, mask = fam.padded()
     d, n = x.shape
     active = volumes > 0
@@ -292,16 +300,25 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     b = -r0.ravel()
     # the part of b outside range(A) (e.g. volumes that do not add up to
     # the enclosed volume) cannot be corrected: least squares drops it
-    P = linear_fields(x, active)
-    b = b - P @ (P.T @ b)
+    keep = active.copy()
+    if exclude is not None:
+        keep[np.asarray(exclude, dtype=np.int64)] = False
+    structured = variant in ("V3", "V5") and exclude is None
+    if structured:
+        P = linear_fields(x, active)
+        b = b - P @ (P.T @ b)
     if solver == "auto":
-        solver = "direct"
+        solver = "direct" if structured else "lsqr"
+    if solver == "direct" and not structured:
+        raise ValueError("the direct VC solve needs V3/V5 without exclude; "
+                         "use solver='lsqr'")
     notes = []
     unknowns = d * nf
 
     def lsqr():  # the full block system, only built when needed
         A = constraint_matrix(phi, B, fam, n)
-        return _solve_lsqr(A, b, tol, maxiter or 20 * unknowns)
+        rows = np.repeat(keep, d)
+        return _solve_lsqr(A[rows], b[rows], tol, maxiter or 20 * unknowns)
 
     if solver == "lsqr":
         alpha, its = lsqr()
@@ -321,10 +338,10 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # phi is 0 if padded
     r1 = constraint_residual(Gc, dx, fam, area)
     rep = VCReport(variant=variant, solver=solver, unknowns=unknowns,
-                   constraints=int(active.sum()) * d,
-                   residual_before=float(np.abs(r0[active]).max()
+                   constraints=int(keep.sum()) * d,
+                   residual_before=float(np.abs(r0[keep]).max()
                                          / area_scale),
-                   residual_after=float(np.abs(r1[active]).max()
+                   residual_after=float(np.abs(r1[keep]).max()
                                         / area_scale),
                    iterations=its, seconds=time.perf_counter() - t0,
                    notes=notes)
@@ -334,3 +351,30 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                       "to round-off. {}".format(rep.residual_after,
                                                 " ".join(notes)))
     return Gc, rep
+
+
+def correction_functions(variant, x, volumes, fam, n=1):
+    r"""Correction functions :math:`\varphi^{ki}`, shape ``(nf, m)`` (zero
+    in padded slots):
+
+    * V1: :math:`1 - \delta_{ki} n_k` (zeroth order only; PPG);
+    * V3, V5: :math:`N^{kki}_{MLS1} - \delta_{ki}` (keep linear
+      consistency; V5 adds the bond projector in :func:`vc_correction`);
+    * V4, VC2: :math:`N^{kki}_{WLS2} - \delta_{ki}` (keep quadratic
+      consistency, for U2).
+    """
+    from .shape import mls1_master_values
+    from .shape.least_squares import wls2_master_values
+    mem, mask = fam.padded()
+    if variant == "V1":
+        phi = mask.astype(float)
+        phi[:, 0] -= fam.sizes
+        return phi
+    if variant in ("V3", "V5"):
+        phi = mls1_master_values(x, volumes, fam, n=n)
+    elif variant in ("V4", "VC2"):
+        phi = wls2_master_values(x, volumes, fam, n=n)
+    else:
+        raise ValueError("no correction function for {!r}".format(variant))
+    phi[:, 0] -= 1.0
+    return phi * mask

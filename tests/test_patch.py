@@ -120,3 +120,23 @@ def test_first_order_variants_fail_the_quadratic_patch_test(kw):
     m, top, _ = quadratic_case()
     r = quadratic_patch_test(m, top, **kw)
     assert r["L2"] > 1e-4 and r["max_error"] > 1e-4
+
+
+def test_v1_ppg_and_v4_u2_pass_the_linear_patch_test():
+    m, top, dirichlet = quadratic_case(12)
+    r = linear_patch_test(m, top, method="PPG1", vc="V1")
+    assert r["max_error"] <= 1e-10  # measured 4.4e-15
+    r = linear_patch_test(m, top, shape="WTE2", vc="V4", vc_exclude=dirichlet)
+    assert r["max_error"] <= 1e-10  # measured 7.3e-12
+    # V4 on all particles: an incompatible system, LSQR leaves 8.5e-4
+    with pytest.warns(UserWarning, match="residual"):
+        r = linear_patch_test(m, top, shape="WTE2", vc="V4")
+    assert r["max_error"] > 1e-6
+
+
+def test_vc_names_and_supports_are_checked():
+    m, top, _ = quadratic_case(6)
+    with pytest.raises(ValueError, match="V1"):
+        pg.FamilyBasis(m, dim=2, vc="V1")  # PBG: V1 breaks the trial
+    with pytest.raises(pg.FamilyError, match="at least 7"):
+        pg.FamilyBasis(m, dim=2, vc="V4")  # WLS2 on FE-connectivity
