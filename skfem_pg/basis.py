@@ -271,6 +271,23 @@ class FamilyBasis(AbstractBasis):
             self.test = copy.copy(self)
             self.test.G = petrov.test_gradients(Gt[:, 0], families, method)
 
+    @classmethod
+    def from_name(cls, particles, name, families=None, **kwargs):
+        """A basis from a thesis name (Table 7.1), e.g.
+        ``FamilyBasis.from_name(p, "VCBCPBG V5 Unl", dim=2)``; see
+        :mod:`skfem_pg.naming`."""
+        from .naming import parse
+        kw, notes = parse(name)
+        basis = cls(particles, families, **{**kw, **kwargs})
+        basis.name_notes = notes
+        return basis
+
+    @property
+    def name(self):
+        """Thesis name, e.g. ``"VCBCPBG V5 Unl"``."""
+        from .naming import name_of
+        return name_of(self)
+
     # ------------------------------------------------------------------
     def _check_families(self):
         p, fam = self.particles, self.families
