@@ -78,11 +78,13 @@ def cook_membrane(n, kind="quad"):
     })
 
 
-def from_geo(path, size=None, order=1, algorithm=None):
+def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
     """Mesh a gmsh ``.geo`` file and load it as a scikit-fem mesh.
 
-    ``size`` sets ``Mesh.MeshSizeMax`` (and scales ``MeshSizeMin``).
-    Physical groups become ``mesh.boundaries``/``mesh.subdomains``.
+    ``size`` sets ``Mesh.MeshSizeMax`` (and scales ``MeshSizeMin``);
+    ``recombine`` recombines 2-D triangles into quadrilaterals (an
+    irregular quad mesh). Physical groups become
+    ``mesh.boundaries``/``mesh.subdomains``.
     """
     import gmsh
     gmsh.initialize(interruptible=False)
@@ -94,6 +96,9 @@ def from_geo(path, size=None, order=1, algorithm=None):
             gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * size)
         if algorithm is not None:
             gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+        if recombine:
+            gmsh.option.setNumber("Mesh.RecombineAll", 1)
+            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
         dim = gmsh.model.getDimension()
         gmsh.model.mesh.generate(dim)
         gmsh.model.mesh.setOrder(order)

@@ -67,3 +67,23 @@ def test_spectrum_tool_and_ppg_stability(block):
         assert c["zero"] == 3 and c["soft"] == 0 and lam[0] > -1e-10
     assert out["U1"][1]["soft"] >= 5
     assert np.sum(out["PPG no BC"][0] < -1e-8) >= 1
+
+
+def test_random_centroid_patch_u1_soft_unl_stable():
+    """Seed 002's patch: ~450 centroids of irregular gmsh quads, 12
+    nearest neighbours.  Measured: U1 137 soft modes, VC PBG Unl none."""
+    from skfem_pg.spectrum import free_modes
+    mesh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"), size=0.11,
+                               recombine=True)
+    p = pg.Particles.from_mesh(mesh, kind="centroids")
+    fam = pg.families.nearest(p, 12, pairwise=True)
+    form = linear_elasticity(*lame(1.0, 0.3))
+    M = np.repeat(p.volumes, 2)
+    lam = {name: free_modes(pg.assemble(form, pg.FamilyBasis(
+        p, fam, dim=2, **kw)), M)["eigenvalues"]
+        for name, kw in {"U1": dict(shape="WTE1"), "Unl": {}}.items()}
+    ref = lam["Unl"][3]
+    for name, ev in lam.items():
+        assert np.sum(np.abs(ev) < 1e-10 * ev[-1]) == 3
+    assert np.sum(lam["Unl"][3:] < 0.5 * ref) == 0
+    assert np.sum(lam["U1"][3:] < 0.5 * ref) >= 50
