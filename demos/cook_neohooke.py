@@ -33,7 +33,8 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
-from skfem_pg.reporting import save_error_vs_time, wall_time
+from skfem_pg.reporting import (print_time_to_target, save_error_vs_time,
+                                wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
@@ -97,15 +98,7 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1):
         print("{size:5.2f} {nodes:6d} {method:24s} {v:9.5f} {err:9.2e} "
               "{l2:9.2e} {newton:4d} {preprocess:7.3f} {assemble:7.3f} "
               "{solve:7.3f}".format(**r) + " {:7.3f}".format(wall_time(r)))
-    print("\nwall time to reach 1 % tip error (first node set that does):")
-    for name in METHODS:
-        hit = [r for r in rows if r["method"] == name and r["err"] <= 0.01]
-        if hit:
-            r = hit[0]
-            print("  {:24s} {:7.3f} s ({} nodes)".format(name, wall_time(r),
-                                                         r["nodes"]))
-        else:
-            print("  {:24s} not reached".format(name))
+    print_time_to_target(rows, METHODS, 0.01, "tip error")
     print("\nconsistent vs finite-difference tangent (VC PBG Unl):")
     for size in sizes:
         c = [r for r in rows if r["size"] == size and

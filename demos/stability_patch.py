@@ -14,7 +14,8 @@ Unl's first deformation mode (spurious soft modes) — and the dynamic one:
 the particle disorder — the particle-scale roughness of the displacement,
 its difference to the MLS1 average of the family (zero for linear, O(h²)
 for smooth fields), relative to the initial stretch — at the end of each
-breathing period, and the energy drift.  Writes demos/out/stability_patch.png (snapshots, disorder vs time)
+breathing period, and the energy drift.  Writes
+demos/out/stability_patch.png (snapshots, disorder vs time)
 and VTUs of the final states.
 
     python demos/stability_patch.py [--periods 10] [--size 0.11]

@@ -237,11 +237,13 @@ def _assemble_bilinear(form, basis, view, vview, kwargs):
         else:
             Ca = C[sl].reshape(nfc, nq, nc, nb * nc, nb).transpose(
                 0, 2, 1, 3, 4)
-        # Y[k, a, (j, β), (c, l)] = sum_γ Ca[k, a, j, (β, c), γ] Ĝv[k, j, l, γ]
+        # Y[k, a, (j, β), (c, l)]
+        #     = sum_γ Ca[k, a, j, (β, c), γ] Ĝv[k, j, l, γ]  (test)
         Y = np.empty((nfc, nc, nq, nb * nc, m))  # matmul's own output
         np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None], out=Y)  # may be
         Y = Y.reshape(nfc, nc, nq * nb, nc * m)  # strided: reshape copies
-        # K[k, a, i, c, l] = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
+        # K[k, a, i, c, l]
+        #     = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
         return np.matmul(GT, Y).reshape(nfc, nc, m, nc, m)
 
     return assemble_local(basis, local_matrices, view, transposed=True)

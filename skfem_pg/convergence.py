@@ -101,7 +101,8 @@ def _scalar_element(mesh):
 def solve_manufactured(mesh, field, lam, mu, scheme="PG", **basis_kwargs):
     """Solve the manufactured problem on ``mesh`` with ``scheme="PG"``
     (``basis_kwargs`` go to :class:`FamilyBasis`, e.g. ``method="PPG1"``)
-    or ``"FE"`` (the mesh's own linear element).  Returns a dict: nodes, h, relative ``L2`` and
+    or ``"FE"`` (the mesh's own linear element).  Returns a dict: nodes,
+    h, relative ``L2`` and
     ``H1`` errors, seconds (setup + assembly + solve)."""
     d = mesh.dim()
     t0 = time.perf_counter()

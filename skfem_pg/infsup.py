@@ -1,11 +1,11 @@
-r"""Numerical inf-sup test (Chapelle & Bathe 1993; thesis 7.2.5, (7.10)–(7.15);
-seed 003, (3.52)–(3.60)).
+r"""Numerical inf-sup test (Chapelle & Bathe 1993; thesis 7.2.5,
+(7.10)–(7.15); seed 003, (3.52)–(3.60)).
 
 For the displacement space :math:`U_h` and the pressure space :math:`P_h` a
 formulation induces, the inf-sup value is :math:`\tilde\beta =
 \sqrt{\lambda_k}`, :math:`\lambda_k` the smallest non-zero eigenvalue of
 
-.. math:: T_h U = \lambda\, S_h U ,                                  \qquad (7.11)
+.. math:: T_h U = \lambda\, S_h U \qquad (7.11)
 
 :math:`S_h` the :math:`H^1` seminorm matrix (:math:`\int\nabla u:\nabla v`,
 (7.12)) and :math:`T_h` the pressure projection of the divergence (7.13):
@@ -16,7 +16,7 @@ pressure space (:math:`B = \int q\,\mathrm{div}\,u`,
 :math:`M_p = \int p\,q`; Q1P0, MINI ...).
 With ``k - 1`` zero eigenvalues, the number of spurious pressure modes is
 
-.. math:: k_{pm} = k - (n_u - n_p + 1).                              \qquad (7.15)
+.. math:: k_{pm} = k - (n_u - n_p + 1) \qquad (7.15)
 
 A formulation passes when :math:`\tilde\beta` stays bounded under refinement
 and :math:`k_{pm} = 0`; a decreasing :math:`\tilde\beta` predicts locking.

@@ -11,6 +11,20 @@ def wall_time(row):
     return row["preprocess"] + row["assemble"] + row["solve"]
 
 
+def print_time_to_target(rows, methods, target=0.01, what="error"):
+    """Print, per method, the wall time of the first row (node set) whose
+    ``err`` is at most ``target``."""
+    print("\nwall time to reach {:g} % {} (first node set that does):"
+          .format(100 * target, what))
+    for name in methods:
+        hit = [r for r in rows if r["method"] == name and r["err"] <= target]
+        if hit:
+            print("  {:24s} {:7.3f} s ({} nodes)".format(
+                name, wall_time(hit[0]), hit[0]["nodes"]))
+        else:
+            print("  {:24s} not reached".format(name))
+
+
 def plot_error_vs_time(ax, rows, styles, ylabel, title, target=0.01):
     """Log-log error against wall time, one line per method in ``styles``
     (``{method: matplotlib format}``), with a horizontal line at

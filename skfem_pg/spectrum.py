@@ -64,7 +64,8 @@ def free_modes(K, M=None, n=None, dense_limit=3000, vectors=False):
 def classify(lam, scale, n_rigid, reference=None, zero_tol=1e-10,
              soft_factor=0.5):
     """Counts of ``zero`` eigenvalues (below ``zero_tol * scale``; those
-    beyond ``n_rigid`` are ``spurious_zero``) and of ``soft`` ones: non-zero modes beyond the ``n_rigid`` lowest that lie
+    beyond ``n_rigid`` are ``spurious_zero``) and of ``soft`` ones:
+    non-zero modes beyond the ``n_rigid`` lowest that lie
     below ``soft_factor * reference`` (e.g. FE's first deformation mode,
     same normalization)."""
     lam = np.asarray(lam)

@@ -1,5 +1,5 @@
-"""Peridynamic Petrov–Galerkin (PPG1/PPG2) test bases (thesis (4.21)–(4.22),
-constraint (5.16))."""
+"""Peridynamic Petrov–Galerkin (PPG1/PPG2) test bases (thesis
+(4.21)–(4.22), constraint (5.16))."""
 import numpy as np
 import pytest
 
