@@ -19,6 +19,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import save_figure
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.spectrum import classify, free_modes
 
@@ -70,7 +71,6 @@ def plot(mesh, spectra, fn):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    os.makedirs(OUT, exist_ok=True)
     fig = plt.figure(figsize=(12, 4.5))
     ax = fig.add_subplot(1, 3, 1)
     for name, s in spectra.items():
@@ -87,10 +87,7 @@ def plot(mesh, spectra, fn):
         ax.scatter(*(mesh.p + v), s=6)
         ax.set_aspect("equal")
         ax.set_title("{}: mode 4".format(name))
-    fig.tight_layout()
-    fig.savefig(fn, dpi=120)
-    plt.close(fig)
-    print("wrote", os.path.relpath(fn))
+    save_figure(fig, fn)
 
 
 if __name__ == "__main__":

@@ -21,6 +21,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import save_figure
 from skfem_pg.analysis import quadratic_patch_test
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
@@ -82,10 +83,7 @@ def plot(results, fn):
         fig.colorbar(sc, ax=ax)
         ax.set_aspect("equal")
         ax.set_title("{}: ε_xy".format(name))
-    fig.tight_layout()
-    fig.savefig(fn, dpi=120)
-    plt.close(fig)
-    print("wrote", os.path.relpath(fn))
+    save_figure(fig, fn)
 
 
 if __name__ == "__main__":

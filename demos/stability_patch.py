@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse.linalg as spl
 
 import skfem_pg as pg
+from skfem_pg.reporting import save_figure
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
 from skfem_pg.models import lame
@@ -178,10 +179,7 @@ def plot(p, runs, fn):
                                                 1e-16))
         ax.set_xlabel("t")
         ax.set_ylabel("disorder")
-    fig.tight_layout()
-    fig.savefig(fn, dpi=110)
-    plt.close(fig)
-    print("wrote", os.path.relpath(fn))
+    save_figure(fig, fn)
 
 
 if __name__ == "__main__":

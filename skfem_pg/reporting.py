@@ -4,6 +4,7 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 ``preprocess``, ``assemble``, ``solve`` (as in
 :attr:`skfem_pg.scenes.Result.times`).
 """
+import os
 
 
 def wall_time(row):
@@ -52,3 +53,13 @@ def save_error_vs_time(fn, rows, styles, ylabel, title, target=0.01):
     fig.tight_layout()
     fig.savefig(fn, dpi=120)
     plt.close(fig)
+
+
+def save_figure(fig, fn, dpi=120):
+    """Tight layout, write ``fn`` (creating its folder), close, say so."""
+    import matplotlib.pyplot as plt
+    os.makedirs(os.path.dirname(os.path.abspath(fn)), exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(fn, dpi=dpi)
+    plt.close(fig)
+    print("wrote", os.path.relpath(fn))

@@ -20,36 +20,56 @@ from .common import (FamilyGeometry, chunks, weights, inverse_spd,
                      raise_singular)
 
 
-def mls1_values(D, V, n=1):
-    r"""MLS1 values from offsets ``D = (X^i - x)/h`` (``(..., k, d)``) and
+def _basis(D, order):
+    """``(1, D)`` (order 1) or ``(1, D, quadratic terms)`` (order 2)."""
+    one = np.ones(D.shape[:-1] + (1,))
+    if order == 1:
+        return np.concatenate([one, D], axis=-1)
+    from .quadratic import taylor2_basis
+    return np.concatenate([one, taylor2_basis(D)], axis=-1)
+
+
+def ls_values(D, V, n=1, order=1):
+    r"""Least-squares shape-function values (MLS1 for ``order=1``, WLS2
+    for ``order=2``) from offsets ``D = (X^i - x)/h`` (``(..., k, d)``) and
     volumes ``V`` (``(..., k)``; 0 for unused slots) of the support
-    particles of evaluation points ``x``: :math:`N^i = \omega^i V^i p^i\cdot
-    M^{-1} e_0`.  Offsets of length 0 get weight 0.  Returns ``(N,
-    singular)``."""
+    particles of evaluation points ``x``: :math:`N^i = \omega^i V^i
+    p^i\cdot M^{-1} e_0`.  Offsets of length 0 get weight 0.  Returns
+    ``(N, singular)``."""
     W = weights((D ** 2).sum(-1), n) * V
-    p = np.concatenate([np.ones(D.shape[:-1] + (1,)), D], axis=-1)
+    p = _basis(D, order)
     M = np.swapaxes(W[..., None] * p, -1, -2) @ p
     Minv, singular = inverse_spd(M)
     return W * (p @ Minv[..., :, :1])[..., 0], singular
 
 
-def mls1_master_values(x, volumes, fam, n=1):
-    """:math:`N_{MLS1}^{kki}`, shape ``(nf, m)`` (zero in padded slots and
-    at the master itself)."""
+def mls1_values(D, V, n=1):
+    """MLS1 values, :func:`ls_values` with ``order=1``."""
+    return ls_values(D, V, n, 1)
+
+
+def _master_values(x, volumes, fam, n, order):
     mem_all, mask_all = fam.padded()
     nf, m = mem_all.shape
     d = x.shape[0]
+    need = d + 1 if order == 1 else 1 + d + d * (d + 1) // 2
     N = np.zeros((nf, m))
     for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        N[sl], singular = mls1_values(geo.D0, geo.V, n)
+        N[sl], singular = ls_values(geo.D0, geo.V, n, order)
         if np.any(singular):
             k = np.nonzero(singular)[0][0]
             raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
-                           None, "MLS1 (master excluded, needs {} members "
+                           None, "{} (master excluded, needs {} members "
                            "besides the master in general position)"
-                           .format(d + 1))
+                           .format("MLS1" if order == 1 else "WLS2", need))
     return N
+
+
+def mls1_master_values(x, volumes, fam, n=1):
+    """:math:`N_{MLS1}^{kki}`, shape ``(nf, m)`` (zero in padded slots and
+    at the master itself)."""
+    return _master_values(x, volumes, fam, n, 1)
 
 
 def wls2_master_values(x, volumes, fam, n=1):
@@ -58,24 +78,4 @@ def wls2_master_values(x, volumes, fam, n=1):
     the master, so :math:`\varphi^{ki} = N^{kki} - \delta_{ki}` (correction
     function V4) is orthogonal to all quadratics.  Needs ``d + d(d+1)/2 + 1``
     non-master members in general position."""
-    from .quadratic import taylor2_basis
-    mem_all, mask_all = fam.padded()
-    nf, m = mem_all.shape
-    d = x.shape[0]
-    N = np.zeros((nf, m))
-    for sl in chunks(nf, m * m):
-        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        D = geo.D0
-        W = weights((D ** 2).sum(-1), n) * geo.V
-        p = np.concatenate([np.ones(D.shape[:-1] + (1,)), taylor2_basis(D)],
-                           axis=-1)
-        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
-        Minv, singular = inverse_spd(M)
-        if np.any(singular):
-            k = np.nonzero(singular)[0][0]
-            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
-                           None, "WLS2 (master excluded, needs {} members "
-                           "besides the master in general position)"
-                           .format(1 + d + d * (d + 1) // 2))
-        N[sl] = W * (p @ Minv[..., :, :1])[..., 0]
-    return N
+    return _master_values(x, volumes, fam, n, 2)
