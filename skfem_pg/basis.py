@@ -31,6 +31,7 @@ zero weight and zero gradient.
 """
 import copy
 import time
+import warnings
 
 import numpy as np
 import skfem as fem
@@ -95,7 +96,8 @@ class FamilyBasis(AbstractBasis):
         ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
         ``"PPG1"`` or ``"PPG2"`` (Peridynamic Petrov–Galerkin (4.21),
         (4.22): non-symmetric, test basis ``basis.test``; families are
-        completed to pairwise ones; PPG2 without VC for now).
+        completed to pairwise ones; PPG2's VC solves (5.17) by LSQR and
+        passes the patch test, but VC PPG2 is unstable, with a warning).
     dim
         Number of field components: ``None`` for a scalar field (e.g.
         Poisson), the spatial dimension for displacements.
@@ -165,10 +167,6 @@ class FamilyBasis(AbstractBasis):
         if vc is not None and vc not in allowed:
             raise ValueError("vc={!r} is not available for {}: use one of {} "
                              "or None".format(vc, method, ", ".join(allowed)))
-        if method == "PPG2" and vc is not None:
-            raise NotImplementedError(
-                "the VC correction of PPG2 (constraint (5.17)) is not "
-                "implemented yet: use method='PPG1' or vc=None")
         if vc == "V5" and not bond:
             raise ValueError("vc='V5' keeps the bond mapping and needs "
                              "bond=True; use vc='V3' without bond correction")
@@ -232,6 +230,16 @@ class FamilyBasis(AbstractBasis):
                 G, self.vc_report = vc2_correction(
                     G, self.dx, x, V, families, area_vectors,
                     particles.area_moments(), phi, exclude=vc_exclude)
+            elif method == "PPG2":  # (5.17), its own sparse system
+                warnings.warn(
+                    "VC PPG2 passes the patch test but is unstable here: "
+                    "its tangent has eigenvalues with negative real part "
+                    "(e.g. 4 on a regular 20x10 block) and it does not "
+                    "converge on a manufactured solution; prefer PPG1")
+                Gm, self.vc_report = petrov.ppg2_vc_correction(
+                    Gt[:, 0], V, families, area_vectors, phi,
+                    exclude=vc_exclude)
+                Gt[:, 0] = Gm
             elif ppg:  # (5.16) is (5.18) with the master weights only
                 Gt, self.vc_report = vc_correction(
                     Gt, dx_t, x, V, families, area_vectors, phi,

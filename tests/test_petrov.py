@@ -104,3 +104,20 @@ def test_ppg1_newton_small_load_matches_linear_and_amg_gmres():
     rhs = rng.standard_normal(len(I))
     x = linear_solver("amg", b.doflocs[:, I], symmetric=False)(A, rhs)
     assert np.linalg.norm(A @ x - rhs) <= 1e-8 * np.linalg.norm(rhs)
+
+
+def test_vc_ppg2_passes_the_patch_test_but_is_unstable():
+    mesh = square(8, 0.3, seed=1)
+    with pytest.warns(UserWarning, match="unstable"):
+        r = linear_patch_test(mesh, TOP[2], method="PPG2")
+    assert r["max_error"] <= 1e-10  # measured 2.7e-14 (10 x 10 set)
+    b = r["basis"]
+    res = constraint_residual(b.test.G, b.dx, b.families,
+                              b.particles.area_vectors())
+    assert np.abs(res).max() < 1e-12
+    # the warning is earned: the free tangent has eigenvalues with negative
+    # real part (measured 18 on this distorted set)
+    from skfem_pg.spectrum import free_modes
+    K = pg.assemble(linear_elasticity(*lame(1.0, 0.4)), b)
+    lam = free_modes(K, np.repeat(b.particles.volumes, 2))["eigenvalues"]
+    assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
