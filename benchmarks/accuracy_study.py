@@ -33,6 +33,7 @@ VARIANTS = {
     "VC PBG Unl, δ = 2.01h": "horizon",
     "VC PPG Unl (BC)": dict(method="PPG1"),
     "VC PPG Unl, no BC": dict(method="PPG1", bond=False),
+    "VC PPG Unl, LME test": dict(method="PPG1", test_shape="LME"),
     "PPG Unl": dict(method="PPG1", vc=None),
 }
 

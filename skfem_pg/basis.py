@@ -44,6 +44,7 @@ from .corrections import bond_correction, correction_functions, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
+from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
 
 METHODS = ("PBG", "PPG1", "PPG2")
@@ -117,6 +118,13 @@ class FamilyBasis(AbstractBasis):
         reach round-off only with these excluded; VC2 then passes the
         quadratic patch test.  Uses the LSQR solve.
 
+    test_shape
+        PPG test derivatives at the masters: ``"master"`` (the trial
+        basis' own derivative there: WTE1 = MTE1 at the master, or WTE2)
+        or ``"LME"`` (local maximum entropy, :mod:`skfem_pg.shape.lme`,
+        locality ``lme_mu``; surface masters, where LME degenerates, keep
+        ``"master"``).
+
     Attributes
     ----------
     G
@@ -136,7 +144,8 @@ class FamilyBasis(AbstractBasis):
 
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
-                 vc_solver="auto", area_vectors=None, vc_exclude=None):
+                 vc_solver="auto", area_vectors=None, vc_exclude=None,
+                 test_shape="master", lme_mu=1.8):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -163,6 +172,12 @@ class FamilyBasis(AbstractBasis):
             raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
                              "trial basis of PBG: shape='WTE2', "
                              "method='PBG'")
+        if test_shape not in ("master", "LME"):
+            raise ValueError("test_shape must be 'master' or 'LME', got {!r}"
+                             .format(test_shape))
+        if test_shape != "master" and not ppg:
+            raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
+                             "use method='PPG1' or 'PPG2'".format(test_shape))
         allowed = ("V1", "V3", "V4") if ppg else ("V3", "V4", "V5", "VC2")
         if vc is not None and vc not in allowed:
             raise ValueError("vc={!r} is not available for {}: use one of {} "
@@ -211,6 +226,9 @@ class FamilyBasis(AbstractBasis):
             self.dx = Vm
             Gt = np.zeros_like(G)  # test derivatives at the masters
             Gt[:, 0] = G[:, 0]
+            if test_shape == "LME":
+                g, ok = lme_master_gradients(x, families, mu=lme_mu)
+                Gt[ok, 0] = g[ok]
             dx_t = np.zeros_like(Vm)
             dx_t[:, 0] = V[families.masters]
         else:

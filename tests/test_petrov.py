@@ -121,3 +121,25 @@ def test_vc_ppg2_passes_the_patch_test_but_is_unstable():
     K = pg.assemble(linear_elasticity(*lame(1.0, 0.4)), b)
     lam = free_modes(K, np.repeat(b.particles.volumes, 2))["eigenvalues"]
     assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
+
+
+def test_lme_test_functions():
+    from skfem_pg.shape.lme import lme_master_gradients
+    mesh = square(8, 0.3, seed=1)
+    p = pg.Particles.from_mesh(mesh)
+    fam = pg.families.from_mesh(p)
+    g, ok = lme_master_gradients(p.x, fam)
+    mem, _ = fam.padded()
+    interior = ~np.isin(fam.masters, mesh.boundary_nodes())
+    assert np.array_equal(ok, interior)  # LME degenerates on the hull
+    lin = np.einsum("kad,kab->kbd", g, p.x.T[mem]) - np.eye(2)
+    assert np.abs(lin[ok]).max() < 1e-9 and np.abs(g.sum(1)).max() < 1e-8
+    r = linear_patch_test(mesh, TOP[2], method="PPG1", test_shape="LME")
+    assert r["max_error"] <= 1e-10  # measured 6.1e-13 (10 x 10 set)
+    r0 = linear_patch_test(mesh, TOP[2], method="PPG1", test_shape="LME",
+                           vc=None)
+    assert r0["max_error"] > 1e-3
+    with pytest.raises(ValueError, match="test_shape"):
+        pg.FamilyBasis(mesh, dim=2, method="PPG1", test_shape="MLS9")
+    with pytest.raises(ValueError, match="Petrov"):
+        pg.FamilyBasis(mesh, dim=2, test_shape="LME")
