@@ -15,7 +15,6 @@ Surface area vectors :math:`A^i = \int_{\partial\Omega} N_i \, n \,d\Gamma`
 (thesis (5.18); FE consistent with the linear boundary facets) are what the
 variationally consistent (VC) correction needs on the surface.
 """
-from typing import Optional
 
 import numpy as np
 from scipy.spatial import cKDTree
