@@ -316,7 +316,8 @@ def assemble(form, basis, vbasis=None, **kwargs):
     passed on to ``form.assemble``.
     """
     if vbasis is None:
-        vbasis = getattr(basis, "test", None) or basis
+        test = getattr(basis, "test", None)
+        vbasis = basis if test is None else test
     view = _view(basis)
     if vbasis is basis:
         vview = view

@@ -62,8 +62,7 @@ def reverse_slots(fam):
     index[fam.masters] = np.arange(nf)
     owner = index[mem]  # family of each member
     # key (family, particle) -> slot, via sorting
-    keys = index[fam.masters][:, None].astype(np.int64) * fam.n_particles \
-        + mem
+    keys = np.arange(nf, dtype=np.int64)[:, None] * fam.n_particles + mem
     flat = np.where(mask, keys, -1).ravel()
     order = np.argsort(flat)
     wanted = (owner * fam.n_particles
