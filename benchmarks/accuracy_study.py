@@ -34,6 +34,9 @@ VARIANTS = {
     "VC PPG Unl (BC)": dict(method="PPG1"),
     "VC PPG Unl, no BC": dict(method="PPG1", bond=False),
     "VC PPG Unl, LME test": dict(method="PPG1", test_shape="LME"),
+    "VC PPG Unl, WLS1 test": dict(method="PPG1", test_shape="WLS1"),
+    "VC PPG U2, WTE1 test": dict(method="PPG1", shape="WTE2",
+                                 test_shape="WTE1"),
     "PPG Unl": dict(method="PPG1", vc=None),
 }
 

@@ -44,10 +44,13 @@ from .corrections import bond_correction, correction_functions, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
+from .shape.least_squares import wls1_master_gradients
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
 
 METHODS = ("PBG", "PPG1", "PPG2")
+#: test derivatives of PPG at the masters
+TEST_SHAPES = ("master", "WTE1", "WLS1", "LME")
 
 
 def pbg_weights(volumes, families):
@@ -120,10 +123,11 @@ class FamilyBasis(AbstractBasis):
 
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
-        basis' own derivative there: WTE1 = MTE1 at the master, or WTE2)
-        or ``"LME"`` (local maximum entropy, :mod:`skfem_pg.shape.lme`,
-        locality ``lme_mu``; surface masters, where LME degenerates, keep
-        ``"master"``).
+        basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
+        ``"WTE1"`` (e.g. the thesis' WTE2–WTE1 combination), ``"WLS1"``
+        (linear least squares with a constant term) or ``"LME"`` (local
+        maximum entropy, :mod:`skfem_pg.shape.lme`, locality ``lme_mu``;
+        surface masters, where LME degenerates, keep ``"master"``).
 
     Attributes
     ----------
@@ -172,9 +176,9 @@ class FamilyBasis(AbstractBasis):
             raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
                              "trial basis of PBG: shape='WTE2', "
                              "method='PBG'")
-        if test_shape not in ("master", "LME"):
-            raise ValueError("test_shape must be 'master' or 'LME', got {!r}"
-                             .format(test_shape))
+        if test_shape not in TEST_SHAPES:
+            raise ValueError("test_shape must be one of {}, got {!r}".format(
+                ", ".join(TEST_SHAPES), test_shape))
         if test_shape != "master" and not ppg:
             raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
                              "use method='PPG1' or 'PPG2'".format(test_shape))
@@ -229,6 +233,12 @@ class FamilyBasis(AbstractBasis):
             if test_shape == "LME":
                 g, ok = lme_master_gradients(x, families, mu=lme_mu)
                 Gt[ok, 0] = g[ok]
+            elif test_shape == "WLS1":
+                Gt[:, 0] = wls1_master_gradients(x, V, families,
+                                                 n=weight_exponent)
+            elif test_shape == "WTE1":
+                Gt[:, 0] = GRADIENTS["WTE1"](x, V, families,
+                                             n=weight_exponent)[:, 0]
             dx_t = np.zeros_like(Vm)
             dx_t[:, 0] = V[families.masters]
         else:

@@ -143,3 +143,19 @@ def test_lme_test_functions():
         pg.FamilyBasis(mesh, dim=2, method="PPG1", test_shape="MLS9")
     with pytest.raises(ValueError, match="Petrov"):
         pg.FamilyBasis(mesh, dim=2, test_shape="LME")
+
+
+@pytest.mark.parametrize("kw", [dict(test_shape="WLS1"),
+                                dict(test_shape="WTE1", shape="WTE2")])
+def test_other_test_functions_pass_the_patch_test(kw):
+    from skfem_pg.shape.least_squares import wls1_master_gradients
+    mesh = square(8, 0.3, seed=1)
+    r = linear_patch_test(mesh, TOP[2], method="PPG1", **kw)
+    assert r["max_error"] <= 1e-10
+    p = pg.Particles.from_mesh(mesh)
+    fam = pg.families.from_mesh(p)
+    mem, _ = fam.padded()
+    g = wls1_master_gradients(p.x, p.volumes, fam)
+    assert np.abs(g.sum(1)).max() < 1e-10
+    lin = np.einsum("kad,kab->kbd", g, p.x.T[mem]) - np.eye(2)
+    assert np.abs(lin).max() < 1e-10

@@ -79,3 +79,30 @@ def wls2_master_values(x, volumes, fam, n=1):
     function V4) is orthogonal to all quadratics.  Needs ``d + d(d+1)/2 + 1``
     non-master members in general position."""
     return _master_values(x, volumes, fam, n, 2)
+
+
+def wls1_master_gradients(x, volumes, fam, n=1):
+    r"""WLS1 derivatives at the masters, ``(nf, m, d)``: the gradient of
+    the weighted linear least-squares fit with a constant term,
+    :math:`\nabla N^i = \omega^{ki}V^i\,(M^{-1} p^{ki})_{1..d}`,
+    :math:`p^{ki} = (1, \Delta X^{ki})`, master weight excluded.  Unlike
+    WTE1 the fit need not pass through the master's value.  A PPG test
+    function option."""
+    mem_all, mask_all = fam.padded()
+    nf, m = mem_all.shape
+    d = x.shape[0]
+    g = np.zeros((nf, m, d))
+    for sl in chunks(nf, m * m):
+        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
+        W = weights((geo.D0 ** 2).sum(-1), n) * geo.V
+        p = _basis(geo.D0, 1)
+        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
+        Minv, singular = inverse_spd(M)
+        if np.any(singular):
+            k = np.nonzero(singular)[0][0]
+            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
+                           None, "WLS1 (master excluded, needs {} members "
+                           "besides the master in general position)"
+                           .format(d + 1))
+        g[sl] = W[..., None] * (p @ Minv)[..., 1:] / geo.h[:, None, None]
+    return g
