@@ -137,7 +137,7 @@ class FamilyBasis(AbstractBasis):
         ``(nf, m)`` weights :math:`w_{kj}` (PPG: :math:`V^j`).
     test
         PPG only: the test basis (same families, dofs and weights, test
-        derivatives of :func:`skfem_pg.petrov.test_gradients`); ``None``
+        derivatives of :func:`skfem_pg.petrov.element_test_gradients`); ``None``
         for PBG.
     vc_report
         :class:`~skfem_pg.corrections.VCReport` (``None`` without VC).
@@ -227,7 +227,7 @@ class FamilyBasis(AbstractBasis):
         mem, mask = families.padded()
         Vm = V[mem] * mask
         if ppg:
-            self.dx = Vm
+            self.dx = petrov.quadrature_weights(V, families)
             Gt = np.zeros_like(G)  # test derivatives at the masters
             Gt[:, 0] = G[:, 0]
             if test_shape == "LME":
@@ -305,7 +305,8 @@ class FamilyBasis(AbstractBasis):
         self._pattern = None
         if ppg:
             self.test = copy.copy(self)
-            self.test.G = petrov.test_gradients(Gt[:, 0], families, method)
+            self.test.G = petrov.element_test_gradients(Gt[:, 0], families,
+                                                         method)
 
     @classmethod
     def from_name(cls, particles, name, families=None, **kwargs):

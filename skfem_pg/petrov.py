@@ -87,7 +87,7 @@ def quadrature_weights(volumes, fam):
     return volumes[mem] * mask
 
 
-def test_gradients(Gt, fam, variant="PPG1"):
+def element_test_gradients(Gt, fam, variant="PPG1"):
     """Test derivatives ``T[f, q, i]`` (shape ``(nf, m, m, d)``) of the
     element view from the master derivatives ``Gt[k, i]`` (``(nf, m, d)``:
     derivative of member ``i`` of family ``k`` at its master)."""

@@ -48,7 +48,7 @@ def test_ppg_is_not_symmetric_and_fast_path_equals_scikit_fem():
         assert np.abs(K @ u).max() < 1e-10 * abs(K).max()
 
 
-def test_test_gradients_sum_to_zero_and_pair_up():
+def test_element_test_gradients_sum_to_zero_and_pair_up():
     mesh = cube(3, 0.3, seed=4, kind="tet")
     b = pg.FamilyBasis(mesh, dim=3, method="PPG1", vc=None)
     T = b.test.G
