@@ -17,7 +17,7 @@ from .basis import FamilyBasis, pbg_weights
 from .assembly import assemble
 from .loads import stress_load
 from .models import lame, linear_elasticity
-from .particles import Particles
+from .particles import Particles, linear_elements
 
 #: displacement gradient of the thesis' linear patch test (7.1)
 PATCH_GRADIENT_2D = np.array([[0.1, 0.3], [0.2, 0.4]])
@@ -126,7 +126,7 @@ def quadratic_patch_test(mesh, neumann, E=100.0, nu=0.3, **basis_kwargs):
     basis = FamilyBasis(particles, dim=2, **basis_kwargs)
     K = assemble(linear_elasticity(lam, mu), basis)
     nf = mesh.normalize_facets(neumann)
-    fb = fem.FacetBasis(mesh, fem.ElementVector(type(mesh).elem()),
+    fb = fem.FacetBasis(mesh, fem.ElementVector(linear_elements(mesh)[0]),
                         facets=nf, intorder=4)
     f = fem.LinearForm(lambda v, w: sum(
         (stress(w.x)[a] * w.n).sum(axis=0) * v[a] for a in range(2))
