@@ -32,9 +32,13 @@ the VC correction of :mod:`~skfem_pg.corrections` (V3, one
 :math:`\alpha^k` per family) applies unchanged.  PPG matrices are not
 symmetric.
 """
+import time
+
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as spl
 
+from .corrections import VCReport, constraint_residual
 from .families import Families
 
 
@@ -125,28 +129,17 @@ def ppg2_vc_correction(Gt, volumes, fam, area, phi, exclude=None, tol=1e-15,
     master (zero for correction functions that sum to zero).  Solved for
     the minimum-norm least-squares solution with LSQR.  Returns
     ``(Gt_corrected, VCReport)``."""
-    import time
-    import scipy.sparse.linalg as spl
-    from .corrections import VCReport
     t0 = time.perf_counter()
     mem, mask = fam.padded()
     nf, m, d = Gt.shape
     n = fam.n_particles
     V = volumes
     Vm = V[mem] * mask
-    index = np.full(n, -1, dtype=np.int64)
-    index[fam.masters] = np.arange(nf)
+    dx = quadrature_weights(V, fam)
 
-    def residual(G):
-        r = -area.T.copy()
-        w = Vm[..., None] * G  # V^k G_t^{fk}: master rows, minus
-        for a in range(d):
-            r[:, a] -= np.bincount(fam.masters, weights=w[..., a].sum(1),
-                                   minlength=n)
-            r[:, a] += np.bincount(mem.ravel(), weights=(
-                V[mem][..., None] * G * mask[..., None])[..., a].ravel(),
-                minlength=n)
-        return r
+    def residual(G):  # the generic constraint of the element view
+        return constraint_residual(element_test_gradients(G, fam, "PPG2"),
+                                   dx, fam, area)
 
     f = np.broadcast_to(np.arange(nf)[:, None], (nf, m))
     rows = np.concatenate([mem[mask], fam.masters])

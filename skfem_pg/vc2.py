@@ -45,36 +45,31 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
-from .corrections import VCReport
+from .corrections import VCReport, constraint_residual
 
 
-def _moments(G, dx, fam, X):
-    """``S1[i, B] = Σ w G`` and ``S2[i, c, B] = Σ w X^j_c G`` (bincounts
-    over the members ``i``)."""
+def _first_moments(G, dx, fam, X):
+    """``S2[i, c, B] = Σ_k Σ_j w_kj X^j_c G^{kji}_B`` (bincount over the
+    members ``i``)."""
     mem, _ = fam.padded()
-    nf, m, _, d = G.shape
-    n = X.shape[1]
-    W = dx[:, :, None, None] * G  # (k, j, i, B)
-    S1 = W.sum(axis=1)  # (k, i, B)
-    Xj = X.T[mem]  # (k, j, c)
-    S2 = np.einsum("kjc,kjiB->kicB", Xj, W)
-    out1 = np.stack([np.bincount(mem.ravel(), weights=S1[..., b].ravel(),
-                                 minlength=n) for b in range(d)], axis=1)
-    out2 = np.zeros((n, d, d))
+    d = G.shape[-1]
+    S2 = np.einsum("kjc,kj,kjiB->kicB", X.T[mem], dx, G)
+    out = np.zeros((X.shape[1], d, d))
     for c in range(d):
         for b in range(d):
-            out2[:, c, b] = np.bincount(mem.ravel(),
-                                        weights=S2[..., c, b].ravel(),
-                                        minlength=n)
-    return out1, out2
+            out[:, c, b] = np.bincount(mem.ravel(),
+                                       weights=S2[..., c, b].ravel(),
+                                       minlength=X.shape[1])
+    return out
 
 
 def vc2_residuals(G, dx, fam, X, V, A, A2):
     """``(r1, r2)``: shapes ``(n, d)`` and ``(n, d, d)`` (``[i, c, B]``);
     ``X`` are positions relative to the origin of ``A2``."""
-    S1, S2 = _moments(G, dx, fam, X)
+    r1 = constraint_residual(G, dx, fam, A)  # (5.18)
+    S1 = r1 + A.T
+    S2 = _first_moments(G, dx, fam, X)
     d = X.shape[0]
-    r1 = S1 - A.T
     r2 = (S2 - X.T[:, :, None] * S1[:, None, :]
           - (np.moveaxis(A2, -1, 0) - X.T[:, :, None] * A.T[:, None, :])
           + V[:, None, None] * np.eye(d))
