@@ -32,7 +32,7 @@ from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
 from skfem_pg.models import lame
 from skfem_pg.shape import mls1_master_values
-from skfem_pg.spectrum import free_modes
+from skfem_pg.spectrum import classify, free_modes
 
 OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
 FORMULATIONS = {"U1 (WTE1)": dict(shape="WTE1"), "VC PBG Unl": dict()}
@@ -119,18 +119,16 @@ def main(periods=10, size=0.11):
     M = np.repeat(p.volumes, 2)
     spectra = {}
     for name, b in bases.items():
-        K = Hyperelastic(b, material).tangent(
-            Hyperelastic(b, material).state(np.zeros(b.N)))
-        spectra[name] = free_modes(K, M)["eigenvalues"]
-    ref = spectra["VC PBG Unl"][3]
+        model = Hyperelastic(b, material)
+        spectra[name] = free_modes(model.tangent(model.state(np.zeros(b.N))),
+                                   M)
+    ref = spectra["VC PBG Unl"]["eigenvalues"][3]
     print("\nstatic view: eigenvalues of the free tangent (M = diag V)")
-    for name, lam_ in spectra.items():
+    for name, s in spectra.items():
+        c = classify(s["eigenvalues"], s["scale"], 3, ref)
         print("  {:12s} zero {:2d}, soft (< {:.3g}) {:3d}, first "
-              "deformation {:.3e}".format(
-                  name, int(np.sum(np.abs(lam_) < 1e-10 * lam_[-1])),
-                  0.5 * ref, int(np.sum((lam_[3:] < 0.5 * ref)
-                                        & (lam_[3:] > 1e-10 * lam_[-1]))),
-                  lam_[3]))
+              "deformation {:.3e}".format(name, c["zero"], 0.5 * ref,
+                                          c["soft"], c["first_deformation"]))
     runs = {}
     print("\ndynamic view: disorder = |u - MLS1 average of u| / "
           "|initial stretch|")
