@@ -131,6 +131,24 @@ def quadratic_patch_test(mesh, neumann, E=100.0, nu=0.3, **basis_kwargs):
     f = fem.LinearForm(lambda v, w: sum(
         (stress(w.x)[a] * w.n).sum(axis=0) * v[a] for a in range(2))
     ).assemble(fb)
+    if basis.area_correction is not None:
+        # discrete surface terms (VC boundary variant 's'/'sn'): for the
+        # linear stress P(x) = P(X^i) + ∇P (x - X^i) the load changes by
+        # P(X^i)·δA^i + ∇P : (δA_2^i - X^i ⊗ δA^i); here on the Neumann
+        # facets only (Dirichlet rows are eliminated anyway)
+        on = np.zeros(particles.n, dtype=bool)
+        on[mesh.facets[:, nf].ravel()] = True
+        x = particles.x
+        dA = basis.area_correction * on
+        P0 = stress(x)  # (a, b, n)
+        df = np.einsum("abn,bn->an", P0, dA)
+        if basis.area2_correction is not None:
+            gradP = stress(np.eye(2)[:, :, None]) - stress(
+                np.zeros((2, 1)))[..., None]  # [a, b, c, 0]: ∂P_ab/∂x_c
+            dA2 = basis.area2_correction * on  # [c, b, n]
+            df += np.einsum("abc,cbn->an", gradP[..., 0],
+                            dA2 - x[:, None, :] * dA[None])
+        f = f + df.T.ravel()
     f = f + np.repeat(particles.volumes, 2) * np.tile(b, particles.n)
     dirichlet = np.setdiff1d(mesh.boundary_facets(), nf)
     D = basis.get_dofs(dirichlet)

@@ -120,6 +120,14 @@ class FamilyBasis(AbstractBasis):
         vectors meet the interpolation error of the surface term), so they
         reach round-off only with these excluded; VC2 then passes the
         quadratic patch test.  Uses the LSQR solve.
+    vc_boundary
+        Boundary conditions of the (singular) first-order VC system,
+        :mod:`skfem_pg.vc_boundary`: ``"min-norm"`` (default; every
+        constraint with FE-consistent :math:`A^i`), or the thesis' ``"p"``,
+        ``"s"``, ``"sn"``.  With ``"s"``/``"sn"`` the surface particles'
+        discrete area vectors (4.35) differ from FE's by
+        ``basis.area_correction``, which the loads of
+        :mod:`skfem_pg.loads` include.
 
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
@@ -141,6 +149,12 @@ class FamilyBasis(AbstractBasis):
         for PBG.
     vc_report
         :class:`~skfem_pg.corrections.VCReport` (``None`` without VC).
+    area_correction
+        ``(dim, np)`` discrete minus FE-consistent surface area vectors
+        (``vc_boundary`` ``"s"``/``"sn"``), else ``None``.
+    area2_correction
+        VC2 with ``vc_boundary="s"``: ``(dim, dim, np)`` discrete minus
+        FE-consistent first area moments :math:`A_2^i`, else ``None``.
     timings
         Seconds spent on families, gradients, bond and VC correction.
 
@@ -149,7 +163,7 @@ class FamilyBasis(AbstractBasis):
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
-                 test_shape="master", lme_mu=1.8):
+                 test_shape="master", lme_mu=1.8, vc_boundary="min-norm"):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -189,6 +203,13 @@ class FamilyBasis(AbstractBasis):
         if vc == "V5" and not bond:
             raise ValueError("vc='V5' keeps the bond mapping and needs "
                              "bond=True; use vc='V3' without bond correction")
+        if vc_boundary != "min-norm" and (
+                vc is None or method == "PPG2"
+                or (vc == "VC2" and vc_boundary != "s")):
+            raise NotImplementedError(
+                "vc_boundary={!r} is implemented for the first-order VC of "
+                "PBG and PPG1 (vc V1, V3, V4, V5) and, 's' only, for VC2; "
+                "not for {} vc={}".format(vc_boundary, method, vc))
         if vc is not None and area_vectors is None and particles.mesh is None:
             raise ValueError(
                 "the VC correction needs surface area vectors A^i: these "
@@ -244,6 +265,7 @@ class FamilyBasis(AbstractBasis):
         else:
             self.dx = pbg_weights(V, families)
         self.vc_report = None
+        self.vc_boundary = vc_boundary
         if vc is not None:
             t0 = time.perf_counter()
             if area_vectors is None:
@@ -257,7 +279,8 @@ class FamilyBasis(AbstractBasis):
             if vc == "VC2":
                 G, self.vc_report = vc2_correction(
                     G, self.dx, x, V, families, area_vectors,
-                    particles.area_moments(), phi, exclude=vc_exclude)
+                    particles.area_moments(), phi, exclude=vc_exclude,
+                    boundary=vc_boundary)
             elif method == "PPG2":  # (5.17), its own sparse system
                 warnings.warn(
                     "VC PPG2 passes the patch test but is unstable here: "
@@ -271,14 +294,20 @@ class FamilyBasis(AbstractBasis):
             elif ppg:  # (5.16) is (5.18) with the master weights only
                 Gt, self.vc_report = vc_correction(
                     Gt, dx_t, x, V, families, area_vectors, phi,
-                    variant=vc, solver=vc_solver, exclude=vc_exclude)
+                    variant=vc, solver=vc_solver, exclude=vc_exclude,
+                    boundary=vc_boundary)
             else:
                 G, self.vc_report = vc_correction(
                     G, self.dx, x, V, families, area_vectors, phi,
-                    variant=vc, solver=vc_solver, exclude=vc_exclude)
+                    variant=vc, solver=vc_solver, exclude=vc_exclude,
+                    boundary=vc_boundary)
             self.timings["vc"] = time.perf_counter() - t0
         self.G = G
         self.test = None
+        self.area_correction = (None if self.vc_report is None
+                                else self.vc_report.area_correction)
+        self.area2_correction = (None if self.vc_report is None
+                                 else self.vc_report.area2_correction)
 
         # --- what scikit-fem's assembly reads ---------------------------
         self.ncomp = dim

@@ -36,6 +36,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from . import vc_boundary
+from .vc_boundary import BOUNDARY_VARIANTS
+
 
 def bond_directions(x, fam):
     """Unit bonds ``e[k, j]`` master → member ``j`` and squared lengths
@@ -96,6 +99,13 @@ class VCReport:
     iterations: int
     seconds: float
     notes: list = field(default_factory=list)
+    boundary: str = "min-norm"
+    #: ``(d, np)`` discrete minus FE area vectors where constraints were
+    #: released (boundary variants ``s``/``sn``), else ``None``
+    area_correction: np.ndarray = None
+    #: VC2 with boundary ``s``: ``(d, d, np)`` discrete minus FE
+    #: :math:`A_2^i` (the surface term of (5.26))
+    area2_correction: np.ndarray = None
 
     def __str__(self):
         return ("VC {}: {} unknowns, {} constraints, solver {} ({} it, "
@@ -183,10 +193,11 @@ def scalar_constraint_matrix(phi, fam, n_particles):
                          shape=(n_particles, len(fam)))
 
 
-def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2):
+def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True):
     r"""Minimum-norm solution of the consistent, singular, square system
     ``A α = b``, :math:`A_{ik} = \varphi^{ki} B^k`, by one *scalar* sparse
-    LU.
+    LU (with ``min_norm=False``: the pinned solution itself, the thesis'
+    boundary variant ``p``).
 
     With :math:`\beta^k = B^k\alpha^k` (``B^k`` is SPD) the system
     decouples into the scalar matrix :math:`\Phi^T` applied to each
@@ -229,6 +240,9 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2):
     beta[cols] = sol[:, :d]
     for _ in range(refine):
         beta[cols] += lu.solve(bb - Ar @ beta)
+    if not min_norm:
+        return (np.linalg.inv(B) @ beta[:, :, None])[..., 0].ravel(), \
+            1 + refine
     z = np.zeros((nf, d + 1))
     z[cols] = sol[:, d:]
     z[fix, np.arange(d + 1)] = 1.0
@@ -242,7 +256,8 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2):
 
 
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
-                  solver="auto", tol=1e-14, maxiter=None, exclude=None):
+                  solver="auto", tol=1e-14, maxiter=None, exclude=None,
+                  boundary="min-norm"):
     """Correct ``G`` so the PBG integration constraint holds.
 
     Parameters
@@ -275,6 +290,17 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         Particles whose constraints are not enforced (Dirichlet particles,
         whose equations are eliminated); needed by V4 for round-off
         patch tests.
+    boundary
+        How the singular system is made regular (:mod:`skfem_pg.vc_boundary`):
+        ``"min-norm"`` (default: all constraints with FE-consistent
+        :math:`A^i`, minimum-norm solution), or the thesis' variants
+        ``"p"`` (V3/V5: correction fixed at ``d + 1`` anchor particles),
+        ``"s"`` (fixed at all surface particles, their constraints
+        released) and ``"sn"`` (normal component fixed at surface
+        particles, the normal constraint released), both by one sparse LU.
+        With ``s``/``sn`` the surface particles' discrete area vectors
+        differ from :math:`A^i` by ``VCReport.area_correction``, which
+        consistent Neumann loads must include.
 
     Returns
     -------
@@ -284,6 +310,18 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     if variant not in ("V1", "V3", "V4", "V5"):
         raise ValueError("VC variant {!r} is not available (V1, V3, V4, "
                          "V5; second order: skfem_pg.vc2)".format(variant))
+    if boundary not in BOUNDARY_VARIANTS:
+        raise ValueError("VC boundary variant {!r} is not available: use "
+                         "one of {}".format(boundary,
+                                            ", ".join(BOUNDARY_VARIANTS)))
+    if boundary != "min-norm" and exclude is not None:
+        raise ValueError("vc_exclude is for the minimum-norm solve; the "
+                         "boundary variants 'p', 's', 'sn' choose the "
+                         "released constraints themselves")
+    if boundary == "p" and variant not in ("V3", "V5"):
+        raise ValueError("boundary variant 'p' pins the d + d² linear "
+                         "modes of V3/V5; {} has others: use 's' or 'sn'"
+                         .format(variant))
     mem, mask = fam.padded()
     d, n = x.shape
     active = volumes > 0
@@ -303,13 +341,19 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     keep = active.copy()
     if exclude is not None:
         keep[np.asarray(exclude, dtype=np.int64)] = False
-    structured = variant in ("V3", "V5") and exclude is None
+    structured = variant in ("V3", "V5") and exclude is None \
+        and boundary in ("min-norm", "p")
     if structured:
         P = linear_fields(x, active)
         b = b - P @ (P.T @ b)
     if solver == "auto":
-        solver = "direct" if structured else "lsqr"
-    if solver == "direct" and not structured:
+        solver = "direct" if structured or boundary in ("s", "sn") \
+            else "lsqr"
+    if boundary in ("s", "sn"):
+        if solver != "direct":
+            raise ValueError("the boundary variants 's'/'sn' are solved by "
+                             "sparse LU (solver='direct' or 'auto')")
+    elif solver == "direct" and not structured:
         raise ValueError("the direct VC solve needs V3/V5 without exclude; "
                          "use solver='lsqr'")
     notes = []
@@ -320,11 +364,23 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         rows = np.repeat(keep, d)
         return _solve_lsqr(A[rows], b[rows], tol, maxiter or 20 * unknowns)
 
-    if solver == "lsqr":
+    if boundary in ("s", "sn"):
+        R, T = vc_boundary.reduction(fam.masters, area, boundary, n, active)
+        try:
+            alpha = vc_boundary.solve_reduced(
+                constraint_matrix(phi, B, fam, n), b, R, T)
+        except RuntimeError as err:
+            raise RuntimeError("VC {} with boundary variant {!r}: {}".format(
+                variant, boundary, err)) from None
+        its, unknowns = 2, T.shape[1]
+        notes.append("boundary {}: {} equations and unknowns".format(
+            boundary, R.shape[0]))
+    elif solver == "lsqr":
         alpha, its = lsqr()
     elif solver == "direct":
         try:
-            alpha, its = _solve_pinned_lu(phi, B, b, x, active, fam)
+            alpha, its = _solve_pinned_lu(phi, B, b, x, active, fam,
+                                          min_norm=boundary == "min-norm")
         except RuntimeError as err:  # singular beyond the linear fields
             notes.append("direct solve failed ({}); fell back to LSQR"
                          .format(err))
@@ -337,14 +393,22 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]  # (nf,m,d)
     Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # phi is 0 if padded
     r1 = constraint_residual(Gc, dx, fam, area)
+    if boundary in ("s", "sn"):  # imposed: R r = 0; the rest moves A^i
+        imposed = (R @ r0.ravel(), R @ r1.ravel())
+        area_correction = r1.T.copy()
+    else:
+        imposed = (r0[keep], r1[keep])
+        area_correction = None
     rep = VCReport(variant=variant, solver=solver, unknowns=unknowns,
-                   constraints=int(keep.sum()) * d,
-                   residual_before=float(np.abs(r0[keep]).max()
+                   constraints=(R.shape[0] if boundary in ("s", "sn")
+                                else int(keep.sum()) * d),
+                   residual_before=float(np.abs(imposed[0]).max()
                                          / area_scale),
-                   residual_after=float(np.abs(r1[keep]).max()
+                   residual_after=float(np.abs(imposed[1]).max()
                                         / area_scale),
                    iterations=its, seconds=time.perf_counter() - t0,
-                   notes=notes)
+                   notes=notes, boundary=boundary,
+                   area_correction=area_correction)
     if rep.residual_after > 1e-8:
         warnings.warn("VC correction left a constraint residual of {:.2e} "
                       "(relative to h^(d-1)); the patch test will not hold "

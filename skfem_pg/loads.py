@@ -10,7 +10,13 @@ functions of the facets the particles were collocated from (4.31)–(4.35):
 * :func:`body_force`: :math:`f^i = \rho_0 b(X^i)\, V^i`.
 
 Because the same :math:`A^i` enter the VC correction, a linear field is
-reproduced exactly (patch test).
+reproduced exactly (patch test).  With the thesis' VC boundary variants
+``s``/``sn`` (:mod:`skfem_pg.vc_boundary`) the surface particles' discrete
+area vectors (4.35) differ from the FE ones by ``basis.area_correction``;
+the loads then use the discrete vectors (4.32), the correction at a
+particle shared in proportion to the part of its area vector lying on the
+loaded ``facets`` (exact on a flat face and wherever all faces of the
+particle carry the same stress).
 """
 import numpy as np
 import skfem as fem
@@ -47,6 +53,18 @@ def traction(basis, facets, t):
         return tv * v
 
     f = load.assemble(fb)
+    dA = _area_correction(basis, facets)
+    if dA is not None:  # |A_h| - |A| times the traction at the particles
+        A = basis.particles.area_vectors(facets)
+        dlen = np.linalg.norm(A + dA, axis=0) - np.linalg.norm(A, axis=0)
+        x = basis.particles.x
+        if callable(t):
+            tv = np.asarray(t(x[:, :, None]), dtype=float)[..., 0]
+        else:
+            tv = np.broadcast_to(np.reshape(np.asarray(t, dtype=float),
+                                            (-1, 1)), (max(1, np.size(t)),
+                                                       x.shape[1]))
+        f = f + (tv * dlen).T.ravel()
     return _resize(f, basis)
 
 
@@ -55,8 +73,25 @@ def stress_load(basis, facets, P):
     stress ``P`` (``(d, d)``) acting on ``facets``."""
     P = np.asarray(P, dtype=float)
     A = basis.particles.area_vectors(facets)
-    f = P @ A  # (d, np)
+    dA = _area_correction(basis, facets)
+    f = P @ (A if dA is None else A + dA)  # (d, np)
     return f.T.ravel()
+
+
+def _area_correction(basis, facets):
+    """The part of ``basis.area_correction`` that belongs to ``facets``:
+    scaled by :math:`|A^i_{facets}| / (|A^i_{facets}| + |A^i - A^i_{facets}|)`;
+    ``None`` if the basis has no correction."""
+    dA = getattr(basis, "area_correction", None)
+    if dA is None:
+        return None
+    p = basis.particles
+    Af = p.area_vectors(facets)
+    on = np.linalg.norm(Af, axis=0)
+    off = np.linalg.norm(p.area_vectors() - Af, axis=0)
+    total = on + off
+    share = np.divide(on, total, out=np.zeros_like(on), where=total > 0)
+    return dA * share
 
 
 def body_force(basis, b, rho=1.0):

@@ -12,11 +12,12 @@ e.g. ``"VCBCPBG V5sn Unl"`` or ``"PPG Unl"``:
 ``U1``      WTE1 (classical correspondence), ``Unl`` MTE1, ``U2`` WTE2
 ==========  ==============================================================
 
-The thesis' boundary variants ``p``, ``s``, ``sn`` fix the correction at
-selected / surface particles; this package solves the minimum-norm problem
-instead (and drops constraints of Dirichlet particles with ``vc_exclude``),
-so those suffixes are accepted and reported in the returned notes.  Mixed
-formulations (``UnlP0``, ``U2P1``, ``Unl+P1C``, ...) are not implemented.
+The thesis' boundary variants ``p``, ``s``, ``sn`` of the VC system (fixed
+correction at selected particles / at surface particles / normal component
+at surface particles) map to ``vc_boundary`` (:mod:`skfem_pg.vc_boundary`);
+without a suffix the package's minimum-norm solve is used
+(``vc_boundary="min-norm"``).  Mixed formulations (``UnlP0``, ``U2P1``,
+``Unl+P1C``, ...) are not implemented.
 """
 import re
 
@@ -56,9 +57,10 @@ def parse(name):
         kw["vc"] = g["variant"] or ("V5" if g["bc"] and method == "PBG"
                                     else "V3")
     if g["boundary"]:
-        notes.append("boundary variant '{}' is solved as the minimum-norm "
-                     "problem here (use vc_exclude for Dirichlet particles)"
-                     .format(g["boundary"]))
+        if kw["vc"] is None:
+            raise ValueError("{!r}: a boundary variant without 'VC'"
+                             .format(name))
+        kw["vc_boundary"] = g["boundary"]
     return kw, notes
 
 
@@ -70,4 +72,6 @@ def name_of(basis):
     method = {"PPG1": "PPG"}.get(basis.method, basis.method)
     form = {v: k for k, v in SHAPES.items()}[basis.shape]
     variant = " V4" if vc == "VC2" else (" " + vc if vc else "")
+    if vc and basis.vc_boundary != "min-norm":
+        variant += basis.vc_boundary
     return "{}{}{} {}".format(prefix, method, variant, form)

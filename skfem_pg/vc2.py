@@ -35,7 +35,12 @@ unknowns with blocks :math:`\varphi^{ki} M^{ki}`,
     m_2^k = \sum_j w_{kj}\Delta X^{kj}\otimes\Delta X^{kj},
 
 solved for its minimum-norm least-squares solution (LSQR; lengths scaled
-by the mean spacing).  Vertex particles of a mesh only (FE-consistent
+by the mean spacing), or, with the thesis' boundary variant ``s``
+(:mod:`skfem_pg.vc_boundary`), with all correction factors of surface
+particles fixed to zero and their constraints released: a square system,
+one sparse LU.  The surface particles' discrete :math:`A^i` and
+:math:`A_2^i` then differ from FE's (``VCReport.area_correction``,
+``area2_correction``).  Vertex particles of a mesh only (FE-consistent
 :math:`A^i`, :math:`A_2^i`).
 """
 import time
@@ -45,6 +50,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from . import vc_boundary
 from .corrections import VCReport, constraint_residual
 
 
@@ -107,12 +113,19 @@ def _system(phi, dx, fam, X, h):
 
 
 def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
-                   tol=1e-15, maxiter=None):
+                   tol=1e-15, maxiter=None, boundary="min-norm"):
     """Second-order VC correction of PBG derivatives ``G`` (quadratic
     consistent, e.g. WTE2); ``area`` :math:`A^i` ``(d, n)``, ``area2``
     :math:`A_2^i` ``(d, d, n)`` about the origin 0, ``phi`` the V4
-    correction function ``(nf, m)``.  Returns ``(G_corrected, VCReport)``.
+    correction function ``(nf, m)``; ``boundary`` ``"min-norm"`` (LSQR)
+    or ``"s"`` (sparse LU).  Returns ``(G_corrected, VCReport)``.
     """
+    if boundary not in ("min-norm", "s"):
+        raise ValueError("VC2 boundary variant {!r} is not available: "
+                         "'min-norm' or 's'".format(boundary))
+    if boundary == "s" and exclude is not None:
+        raise ValueError("vc_exclude is for the minimum-norm solve; "
+                         "boundary 's' releases all surface constraints")
     t0 = time.perf_counter()
     d, n = x.shape
     mem, mask = fam.padded()
@@ -125,15 +138,36 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
     keep = active.copy()
     if exclude is not None:
         keep[np.asarray(exclude, dtype=np.int64)] = False
-    A = A[np.repeat(keep, d + 1)]
-    rhs = rhs[keep]
     alpha = np.zeros((len(fam), d + 1, d))
-    its = 0
-    for b in range(d):
-        sol = spl.lsqr(A, rhs[:, :, b].ravel(), atol=tol, btol=tol,
-                       conlim=1e12, iter_lim=maxiter or 50 * A.shape[1])
-        alpha[:, :, b] = sol[0].reshape(-1, d + 1)
-        its = max(its, sol[2])
+    if boundary == "s":
+        surf, _, _ = vc_boundary.surface_frames(area)
+        keep[surf] = False
+        cols = np.nonzero(keep[fam.masters])[0]
+        K = A[np.repeat(keep, d + 1)][:, (
+            (d + 1) * cols[:, None] + np.arange(d + 1)).ravel()].tocsc()
+        if K.shape[0] != K.shape[1]:
+            raise ValueError("VC2 boundary 's' needs one family per "
+                             "particle ({} equations, {} unknowns)"
+                             .format(*K.shape))
+        rhs = rhs[keep].reshape(-1, d)
+        try:
+            lu = spl.splu(K, permc_spec="COLAMD")
+        except RuntimeError as err:
+            raise RuntimeError("the VC2 system with boundary 's' is "
+                               "singular ({})".format(err)) from None
+        sol = lu.solve(rhs)
+        sol += lu.solve(rhs - K @ sol)
+        alpha[cols] = sol.reshape(len(cols), d + 1, d)
+        its, solver = 2, "direct"
+    else:
+        A = A[np.repeat(keep, d + 1)]
+        rhs = rhs[keep]
+        its, solver = 0, "lsqr"
+        for b in range(d):
+            sol = spl.lsqr(A, rhs[:, :, b].ravel(), atol=tol, btol=tol,
+                           conlim=1e12, iter_lim=maxiter or 50 * A.shape[1])
+            alpha[:, :, b] = sol[0].reshape(-1, d + 1)
+            its = max(its, sol[2])
     P = (x / h).T[mem]
     dX = (P - P[:, :1]) * mask[..., None]  # (k, j, c) scaled
     # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
@@ -144,11 +178,19 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
     scale = h ** (d - 1)
     before = max(np.abs(r1[keep]).max(), np.abs(r2[keep]).max() / h)
     after = max(np.abs(s1[keep]).max(), np.abs(s2[keep]).max() / h)
-    rep = VCReport(variant="VC2 (V4)", solver="lsqr", unknowns=A.shape[1] * d,
-                   constraints=A.shape[0] * d,
+    rep = VCReport(variant="VC2 (V4)", solver=solver,
+                   unknowns=(d + 1) * d * (len(cols) if boundary == "s"
+                                           else len(fam)),
+                   constraints=(d + 1) * d * int(keep.sum()),
                    residual_before=float(before / scale),
                    residual_after=float(after / scale), iterations=int(its),
-                   seconds=time.perf_counter() - t0)
+                   seconds=time.perf_counter() - t0, boundary=boundary)
+    if boundary == "s":
+        rep.area_correction = s1.T.copy()
+        # r2 = S2 - X⊗S1 - (A2 - X⊗A) + V I: discrete minus FE A2 is
+        # r2 + X⊗r1, stored as (d, d, n) like A2
+        rep.area2_correction = np.moveaxis(
+            s2 + x.T[:, :, None] * s1[:, None, :], 0, -1).copy()
     if rep.residual_after > 1e-8:
         warnings.warn("VC2 left a constraint residual of {:.2e} (relative "
                       "to h^(d-1)); the full second-order system is "

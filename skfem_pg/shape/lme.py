@@ -21,9 +21,8 @@ for all at once).
 import numpy as np
 
 
-
 def lme_master_gradients(x, fam, mu=1.8, tol=1e-12, maxiter=60):
-    """LME derivatives at the masters, ``(nf, m, d)`` (member ``a`` of
+    r"""LME derivatives at the masters, ``(nf, m, d)`` (member ``a`` of
     family ``k`` at :math:`X^k`; zero in padded slots), and a boolean
     ``(nf,)`` array ``ok``.  A master on the convex hull of its family (a
     surface particle) has no finite :math:`\lambda` — LME degenerates
