@@ -44,13 +44,19 @@ from .corrections import bond_correction, correction_functions, vc_correction
 from .errors import FamilyError, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
-from .shape.least_squares import wls1_master_gradients
+from .shape.least_squares import (mls1_master_gradients,
+                                   wls1_master_gradients,
+                                   wls2_master_gradients)
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
 
 METHODS = ("PBG", "PPG1", "PPG2")
 #: test derivatives of PPG at the masters
-TEST_SHAPES = ("master", "WTE1", "WLS1", "LME")
+#: least-squares PPG test derivatives at the masters
+LS_TEST_GRADIENTS = {"WLS1": wls1_master_gradients,
+                     "WLS2": wls2_master_gradients,
+                     "MLS1": mls1_master_gradients}
+TEST_SHAPES = ("master", "WTE1", "WLS1", "WLS2", "MLS1", "LME")
 
 
 def pbg_weights(volumes, families):
@@ -91,7 +97,9 @@ class FamilyBasis(AbstractBasis):
         correction_functions`): ``"V5"`` (default with bond correction),
         ``"V3"`` (default for MTE1 without bond correction, for WTE2 and
         for PPG, whose test derivatives it corrects), ``"V4"`` (keeps
-        quadratic consistency), ``"V1"`` (PPG only), ``None`` (default for
+        quadratic consistency), ``"V2"`` (second derivatives of WLS2
+        (5.61), keeps linear consistency; families of ``2 + q`` members
+        and more), ``"V1"`` (PPG only), ``None`` (default for
         WTE1: the classical, uncorrected method), or
         ``"VC2"`` (second-order VC with V4 correction functions, for
         ``shape="WTE2"``: passes the quadratic patch test;
@@ -133,7 +141,9 @@ class FamilyBasis(AbstractBasis):
         PPG test derivatives at the masters: ``"master"`` (the trial
         basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
         ``"WTE1"`` (e.g. the thesis' WTE2–WTE1 combination), ``"WLS1"``
-        (linear least squares with a constant term) or ``"LME"`` (local
+        (linear least squares with a constant term), ``"WLS2"`` (its
+        quadratic version), ``"MLS1"`` (moving least squares: weights and
+        moment matrix differentiated too) or ``"LME"`` (local
         maximum entropy, :mod:`skfem_pg.shape.lme`, locality ``lme_mu``;
         surface masters, where LME degenerates, keep ``"master"``).
 
@@ -196,7 +206,8 @@ class FamilyBasis(AbstractBasis):
         if test_shape != "master" and not ppg:
             raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
                              "use method='PPG1' or 'PPG2'".format(test_shape))
-        allowed = ("V1", "V3", "V4") if ppg else ("V3", "V4", "V5", "VC2")
+        allowed = (("V1", "V2", "V3", "V4") if ppg
+                   else ("V2", "V3", "V4", "V5", "VC2"))
         if vc is not None and vc not in allowed:
             raise ValueError("vc={!r} is not available for {}: use one of {} "
                              "or None".format(vc, method, ", ".join(allowed)))
@@ -217,6 +228,7 @@ class FamilyBasis(AbstractBasis):
                 "(dim, n)) or use vc=None")
         self.particles = particles
         self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
+        self.test_shape = test_shape
         self.weight_exponent = weight_exponent
         self.timings = {}
         x, V = particles.x, particles.volumes
@@ -254,9 +266,9 @@ class FamilyBasis(AbstractBasis):
             if test_shape == "LME":
                 g, ok = lme_master_gradients(x, families, mu=lme_mu)
                 Gt[ok, 0] = g[ok]
-            elif test_shape == "WLS1":
-                Gt[:, 0] = wls1_master_gradients(x, V, families,
-                                                 n=weight_exponent)
+            elif test_shape in LS_TEST_GRADIENTS:
+                Gt[:, 0] = LS_TEST_GRADIENTS[test_shape](
+                    x, V, families, n=weight_exponent)
             elif test_shape == "WTE1":
                 Gt[:, 0] = GRADIENTS["WTE1"](x, V, families,
                                              n=weight_exponent)[:, 0]
@@ -372,8 +384,8 @@ class FamilyBasis(AbstractBasis):
         q = d + d * (d + 1) // 2  # quadratic basis without constant
         if self.shape == "WTE2":
             need = max(need, 1 + q)
-        if self.vc in ("V4", "VC2"):  # WLS2 with a constant term
-            need = max(need, 2 + q)
+        if self.vc in ("V2", "V4", "VC2") or self.test_shape == "WLS2":
+            need = max(need, 2 + q)  # WLS2 with a constant term
         families_mod.check_supports(p, fam, need, "{}{}".format(
             self.shape, " with VC correction" if self.vc else ""))
 

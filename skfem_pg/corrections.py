@@ -118,14 +118,19 @@ class VCReport:
 def constraint_matrix(phi, B, fam, n_particles):
     r"""Sparse :math:`\partial r / \partial \alpha`: block ``(i, k)`` is
     :math:`\varphi^{ki} B^k`, :math:`B^k = \sum_j w_{kj} Q^{kj}`; shape
-    ``(d·np, d·nf)``."""
+    ``(d·np, d·nf)``.  Matrix-valued correction functions (V2,
+    ``phi`` of shape ``(nf, m, d, d)``) give blocks :math:`\varphi^{ki}
+    B^k`."""
     mem, mask = fam.padded()
     nf, m = mem.shape
     d = B.shape[-1]
     a = np.arange(d)
     k = np.broadcast_to(np.arange(nf)[:, None], (nf, m))[mask]
     i = mem[mask]
-    vals = phi[mask][:, None, None] * B[k]  # (nnzb, d, d)
+    if phi.ndim == 4:
+        vals = phi[mask] @ B[k]
+    else:
+        vals = phi[mask][:, None, None] * B[k]  # (nnzb, d, d)
     rows = d * i[:, None, None] + a[None, :, None]
     cols = d * k[:, None, None] + a[None, None, :]
     rows, cols = np.broadcast_arrays(rows, cols)
@@ -258,7 +263,7 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True):
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                   solver="auto", tol=1e-14, maxiter=None, exclude=None,
                   boundary="min-norm"):
-    """Correct ``G`` so the PBG integration constraint holds.
+    r"""Correct ``G`` so the PBG integration constraint holds.
 
     Parameters
     ----------
@@ -277,11 +282,13 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         (:func:`correction_functions`).
     variant
         ``"V5"`` (with bond projector, keeps the bond mapping), ``"V3"``,
-        ``"V4"`` or ``"V1"`` (no projector).
+        ``"V4"``, ``"V1"`` (no projector) or ``"V2"`` (matrix-valued
+        :math:`\varphi^{ki} = \partial^2 N^{ki}_{WLS2}` (5.61),
+        :math:`C^{kji} = \varphi^{ki}\alpha^k`).
     solver
         ``"direct"`` (one scalar sparse LU of the pinned system; the
         default, ``"auto"``) or ``"lsqr"`` (scipy LSQR; a reference, its
-        iteration count grows with the node count).  V1 and V4, and any
+        iteration count grows with the node count).  V1, V2 and V4, and any
         ``exclude``, take LSQR: their systems lack the structure the
         direct solve relies on (V4's left null space holds the quadratic
         fields and is incompatible with the surface terms, V1 does not
@@ -307,9 +314,10 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     G_corrected, VCReport
 
     """
-    if variant not in ("V1", "V3", "V4", "V5"):
-        raise ValueError("VC variant {!r} is not available (V1, V3, V4, "
-                         "V5; second order: skfem_pg.vc2)".format(variant))
+    if variant not in ("V1", "V2", "V3", "V4", "V5"):
+        raise ValueError("VC variant {!r} is not available (V1, V2, V3, "
+                         "V4, V5; second order: skfem_pg.vc2)"
+                         .format(variant))
     if boundary not in BOUNDARY_VARIANTS:
         raise ValueError("VC boundary variant {!r} is not available: use "
                          "one of {}".format(boundary,
@@ -390,8 +398,12 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         raise ValueError("unknown VC solver {!r}: use 'direct', 'lsqr' or "
                          "'auto'".format(solver))
     alpha = alpha.reshape(-1, d)
-    Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]  # (nf,m,d)
-    Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # phi is 0 if padded
+    if phi.ndim == 4:  # V2: C^{kji} = phi^{ki} alpha^k for every member j
+        Ha = (phi @ alpha[:, None, :, None])[..., 0]  # (nf, m_i, d)
+        Gc = G + mask[:, :, None, None] * Ha[:, None, :, :]
+    else:
+        Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]
+        Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # 0 if padded
     r1 = constraint_residual(Gc, dx, fam, area)
     if boundary in ("s", "sn"):  # imposed: R r = 0; the rest moves A^i
         imposed = (R @ r0.ravel(), R @ r1.ravel())
@@ -410,10 +422,14 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                    notes=notes, boundary=boundary,
                    area_correction=area_correction)
     if rep.residual_after > 1e-8:
+        hint = (" {}'s full system is incompatible: release the surface "
+                "constraints (vc_boundary='s' or 'sn') or pass the Dirichlet "
+                "particles as vc_exclude.".format(variant)
+                if variant in ("V2", "V4") else "")
         warnings.warn("VC correction left a constraint residual of {:.2e} "
                       "(relative to h^(d-1)); the patch test will not hold "
-                      "to round-off. {}".format(rep.residual_after,
-                                                " ".join(notes)))
+                      "to round-off.{} {}".format(rep.residual_after, hint,
+                                                  " ".join(notes)))
     return Gc, rep
 
 
@@ -422,18 +438,23 @@ def correction_functions(variant, x, volumes, fam, n=1):
     in padded slots):
 
     * V1: :math:`1 - \delta_{ki} n_k` (zeroth order only; PPG);
+    * V2: :math:`\partial^2 N^{ki}_{WLS2}` (5.61), shape ``(nf, m, d, d)``
+      (keeps linear consistency);
     * V3, V5: :math:`N^{kki}_{MLS1} - \delta_{ki}` (keep linear
       consistency; V5 adds the bond projector in :func:`vc_correction`);
     * V4, VC2: :math:`N^{kki}_{WLS2} - \delta_{ki}` (keep quadratic
       consistency, for U2).
     """
     from .shape import mls1_master_values
-    from .shape.least_squares import wls2_master_values
+    from .shape.least_squares import wls2_master_hessians, wls2_master_values
     mem, mask = fam.padded()
     if variant == "V1":
         phi = mask.astype(float)
         phi[:, 0] -= fam.sizes
         return phi
+    if variant == "V2":
+        return wls2_master_hessians(x, volumes, fam, n=n) \
+            * mask[..., None, None]
     if variant in ("V3", "V5"):
         phi = mls1_master_values(x, volumes, fam, n=n)
     elif variant in ("V4", "VC2"):

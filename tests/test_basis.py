@@ -96,8 +96,8 @@ def test_bad_options_are_named():
         pg.FamilyBasis(p, shape="MTE2")
     with pytest.raises(ValueError, match="bond=True"):
         pg.FamilyBasis(p, bond=False, vc="V5")
-    with pytest.raises(ValueError, match="V2"):
-        pg.FamilyBasis(p, vc="V2")
+    with pytest.raises(ValueError, match="V6"):
+        pg.FamilyBasis(p, vc="V6")
 
 
 def test_vc_falls_back_to_lsqr_when_a_particle_masters_no_family():

@@ -103,3 +103,48 @@ def test_wte2_reproduces_quadratic_gradients(d):
     # ill-conditioned 7-member boundary families reach 7e-10
     assert err.max() < 1e-8
     assert np.abs(G.sum(axis=2)).max() < 1e-10
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_least_squares_master_derivatives(d):
+    """WLS1/MLS1 gradients reproduce linear fields, WLS2 gradients and
+    Hessians (the V2 correction functions) quadratic ones; MLS1 against
+    finite differences of the moving fit."""
+    from skfem_pg.shape import least_squares as ls
+    p = random_particles(d, n=80, seed=7)
+    fam = pg.families.nearest(p, 14 if d == 2 else 24)
+    mem, mask = fam.padded()
+    X = p.x.T[mem] * mask[..., None]
+    A = np.arange(1.0, 1.0 + d * d).reshape(d, d) / d ** 2
+    u = np.einsum("ak,ab,bk->k", p.x, A, p.x)  # X·A·X
+    for fn in (ls.wls1_master_gradients, ls.mls1_master_gradients,
+               ls.wls2_master_gradients):
+        g = fn(p.x, p.volumes, fam)
+        assert np.abs(g.sum(1)).max() < 1e-9
+        assert np.abs(np.einsum("kia,kib->kab", X, g) - np.eye(d)).max() \
+            < 1e-9
+    g2 = ls.wls2_master_gradients(p.x, p.volumes, fam)
+    exact = ((A + A.T) @ p.x[:, fam.masters]).T
+    assert np.abs(np.einsum("ki,kia->ka", u[mem] * mask, g2) - exact).max() \
+        < 1e-8
+    H = ls.wls2_master_hessians(p.x, p.volumes, fam)
+    assert np.abs(H.sum(1)).max() < 1e-8
+    assert np.abs(np.einsum("kia,kibc->kabc", X, H)).max() < 1e-8
+    assert np.abs(np.einsum("ki,kiab->kab", u[mem] * mask, H)
+                  - (A + A.T)).max() < 1e-8
+    # MLS1: the derivative of the moving fit (master excluded)
+    g = ls.mls1_master_gradients(p.x, p.volumes, fam)
+    assert np.abs(g - ls.wls1_master_gradients(p.x, p.volumes, fam)).max() \
+        > 1e-3  # it is not the static one
+    k, eps = 5, 1e-6
+    others = mem[k][mask[k]][1:]
+    xk = p.x[:, fam.masters[k]]
+
+    def values(pt):
+        N, _ = ls.ls_values((p.x[:, others].T - pt)[None],
+                            p.volumes[others][None])
+        return N[0]
+    fd = np.array([(values(xk + eps * e) - values(xk - eps * e)) / (2 * eps)
+                   for e in np.eye(d)]).T
+    assert np.abs(fd - g[k, 1:len(others) + 1]).max() < 1e-6 * np.abs(
+        fd).max()

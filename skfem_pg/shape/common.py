@@ -13,6 +13,10 @@ from ..errors import FamilyError, describe_particle
 
 #: a normalised moment matrix with determinant below this is singular
 SINGULAR_TOL = 1e-10
+#: for larger (quadratic) moment matrices, whose normalised determinant is
+#: tiny even when they are well conditioned (their eigenvalues scale with
+#: different powers of h): reciprocal condition number below this
+SINGULAR_RCOND = 1e-12
 
 
 class FamilyGeometry:
@@ -98,19 +102,25 @@ def inverse_spd(M):
     """Batched inverse of symmetric positive semi-definite matrices.
 
     Returns ``(inverse, singular)``; singular matrices (normalised
-    determinant below :data:`SINGULAR_TOL`) are replaced by the identity so
-    the caller can report them and carry on with finite numbers.
+    determinant below :data:`SINGULAR_TOL` for ``q <= 3``, reciprocal
+    condition number below :data:`SINGULAR_RCOND` for larger ones) are
+    replaced by the identity so the caller can report them and carry on
+    with finite numbers.
     """
     q = M.shape[-1]
     tr = np.trace(M, axis1=-2, axis2=-1) / q
     s = np.where(tr > 0, tr, 1.0)
     Mn = M / s[..., None, None]
-    det = _det(Mn)
-    singular = ~(det > SINGULAR_TOL)
+    if q <= 3:
+        det = _det(Mn)
+        singular = ~(det > SINGULAR_TOL)
+    else:
+        lam = np.linalg.eigvalsh(Mn)
+        singular = ~(lam[..., 0] > SINGULAR_RCOND * lam[..., -1])
     eye = np.eye(q)
     Mn = np.where(singular[..., None, None], eye, Mn)
     if q <= 3:
-        inv = _inv_closed(Mn, np.where(singular, 1.0, det))
+        inv = _inv_closed(Mn, np.where(singular, 1.0, det))  # noqa: F821
     else:
         inv = np.linalg.inv(Mn)
     return inv / s[..., None, None], singular

@@ -48,22 +48,81 @@ def mls1_values(D, V, n=1):
     return ls_values(D, V, n, 1)
 
 
-def _master_values(x, volumes, fam, n, order):
+def master_fits(x, volumes, fam, n=1, order=1, moving=False):
+    r"""Weighted least-squares fits about the masters, master weight
+    excluded: coefficients :math:`c^{ki} = \omega^{ki}V^i (M^k)^{-1}p^{ki}`
+    (``(nf, m, 1 + d)`` for order 1, ``(nf, m, 1 + d + q)`` for order 2,
+    in the scaled offsets :math:`D = \Delta X/h_k`) and the family radii
+    ``h`` (``(nf,)``).  :math:`N^{ki}(X) = p((X - X^k)/h_k)\cdot c^{ki}`
+    is the static (WLS) shape function; its value at the master is
+    ``c[..., 0]``, its gradient ``c[..., 1:1+d] / h`` and, for order 2, its
+    constant Hessian from the quadratic coefficients.
+
+    With ``moving=True`` (order 1 only) also the MLS1 derivatives at the
+    master, ``(nf, m, d)``, which include the derivatives of the weights
+    and of the moment matrix with respect to the evaluation point
+    (:math:`D^i = (X^i - x)/h`, :math:`\partial p^i/\partial x_a =
+    -E_a/h`, :math:`\partial W^i/\partial x_a = 2n W^i D^i_a/(|D^i|^2 h)`):
+
+    .. math:: \partial_a N^i = \partial_a W^i\, p^i\cdot M^{-1}e_0
+        + W^i\,\partial_a p^i\cdot M^{-1}e_0
+        - W^i p^i\cdot M^{-1}(\partial_a M) M^{-1}e_0 .
+    """
     mem_all, mask_all = fam.padded()
     nf, m = mem_all.shape
     d = x.shape[0]
     need = d + 1 if order == 1 else 1 + d + d * (d + 1) // 2
-    N = np.zeros((nf, m))
+    nb = need
+    c = np.zeros((nf, m, nb))
+    h = np.ones(nf)
+    grad = np.zeros((nf, m, d)) if moving else None
     for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        N[sl], singular = ls_values(geo.D0, geo.V, n, order)
+        r2 = (geo.D0 ** 2).sum(-1)
+        W = weights(r2, n) * geo.V
+        p = _basis(geo.D0, order)
+        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
+        Minv, singular = inverse_spd(M)
         if np.any(singular):
             k = np.nonzero(singular)[0][0]
             raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
                            None, "{} (master excluded, needs {} members "
                            "besides the master in general position)"
-                           .format("MLS1" if order == 1 else "WLS2", need))
-    return N
+                           .format("WLS{}".format(order), need))
+        c[sl] = W[..., None] * (p @ Minv)
+        h[sl] = geo.h
+        if moving:
+            grad[sl] = _mls1_master_gradients(geo.D0, r2, W, p, Minv, n) \
+                / geo.h[:, None, None]
+    return (c, h, grad) if moving else (c, h)
+
+
+def _mls1_master_gradients(D, r2, W, p, Minv, n):
+    """MLS1 derivatives at the master in scaled coordinates (times h);
+    offsets ``D = (X^i - X^k)/h`` (so the evaluation point is the master)."""
+    d = D.shape[-1]
+    a0 = Minv[..., :, 0]  # M^{-1} e0, (nf, q)
+    pa = (p * a0[:, None, :]).sum(-1)  # p^i·M^{-1}e0, (nf, m)
+    safe = np.where(r2 > 0, r2, 1.0)
+    dW = np.where(r2 > 0, 2.0 * n * W / safe, 0.0)[..., None] * D  # (nf,m,d)
+    g = np.empty(D.shape)
+    for a in range(d):
+        Ea = np.zeros(p.shape[-1])
+        Ea[1 + a] = 1.0
+        dp = -np.broadcast_to(Ea, p.shape) * (W > 0)[..., None]  # -E_a
+        # dM = Σ_l dW_l p p^T + W_l (dp p^T + p dp^T)
+        dM = np.einsum("fl,flq,flr->fqr", dW[..., a], p, p) + np.einsum(
+            "fl,flq,flr->fqr", W, dp, p)
+        dM = dM + np.swapaxes(dM - np.einsum("fl,flq,flr->fqr", dW[..., a],
+                                             p, p), -1, -2)
+        b = (Minv @ (dM @ a0[..., None]))[..., 0]  # M^-1 dM M^-1 e0
+        g[..., a] = (dW[..., a] * pa + W * (dp * a0[:, None, :]).sum(-1)
+                     - W * (p * b[:, None, :]).sum(-1))
+    return g
+
+
+def _master_values(x, volumes, fam, n, order):
+    return master_fits(x, volumes, fam, n, order)[0][..., 0]
 
 
 def mls1_master_values(x, volumes, fam, n=1):
@@ -88,21 +147,41 @@ def wls1_master_gradients(x, volumes, fam, n=1):
     :math:`p^{ki} = (1, \Delta X^{ki})`, master weight excluded.  Unlike
     WTE1 the fit need not pass through the master's value.  A PPG test
     function option."""
-    mem_all, mask_all = fam.padded()
-    nf, m = mem_all.shape
+    c, h = master_fits(x, volumes, fam, n, 1)
     d = x.shape[0]
-    g = np.zeros((nf, m, d))
-    for sl in chunks(nf, m * m):
-        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        W = weights((geo.D0 ** 2).sum(-1), n) * geo.V
-        p = _basis(geo.D0, 1)
-        M = np.swapaxes(W[..., None] * p, -1, -2) @ p
-        Minv, singular = inverse_spd(M)
-        if np.any(singular):
-            k = np.nonzero(singular)[0][0]
-            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
-                           None, "WLS1 (master excluded, needs {} members "
-                           "besides the master in general position)"
-                           .format(d + 1))
-        g[sl] = W[..., None] * (p @ Minv)[..., 1:] / geo.h[:, None, None]
-    return g
+    return c[..., 1:1 + d] / h[:, None, None]
+
+
+def wls2_master_gradients(x, volumes, fam, n=1):
+    r"""WLS2 derivatives at the masters, ``(nf, m, d)``: the gradient at
+    :math:`X^k` of the weighted quadratic least-squares fit (constant
+    term included, master weight excluded); exact for quadratic fields.
+    A PPG test function option."""
+    c, h = master_fits(x, volumes, fam, n, 2)
+    d = x.shape[0]
+    return c[..., 1:1 + d] / h[:, None, None]
+
+
+def wls2_master_hessians(x, volumes, fam, n=1):
+    r"""Second derivatives of the WLS2 shape functions, constant over the
+    family, ``(nf, m, d, d)``: :math:`\partial^2 N^{ki}_{WLS2}`, the
+    correction function V2 (5.61).  They annihilate constant and linear
+    fields: :math:`\sum_i \partial^2 N^{ki} = 0`,
+    :math:`\sum_i \Delta X^{ki}\otimes\partial^2 N^{ki} = 0`."""
+    from .quadratic import quadratic_terms
+    c, h = master_fits(x, volumes, fam, n, 2)
+    d = x.shape[0]
+    H = np.zeros(c.shape[:2] + (d, d))
+    for t, (a, b) in enumerate(quadratic_terms(d)):
+        coef = c[..., 1 + d + t]
+        H[..., a, b] += coef
+        H[..., b, a] += coef
+    return H / (h ** 2)[:, None, None, None]
+
+
+def mls1_master_gradients(x, volumes, fam, n=1):
+    r"""MLS1 derivatives at the masters, ``(nf, m, d)``: the moving
+    least-squares derivative (weights and moment matrix differentiated
+    with the evaluation point, :func:`master_fits`), master weight
+    excluded.  Linearly consistent; a PPG test function option."""
+    return master_fits(x, volumes, fam, n, 1, moving=True)[2]
