@@ -101,8 +101,9 @@ class FamilyBasis(AbstractBasis):
         (5.61), keeps linear consistency; families of ``2 + q`` members
         and more), ``"V1"`` (PPG only), ``None`` (default for
         WTE1: the classical, uncorrected method), or
-        ``"VC2"`` (second-order VC with V4 correction functions, for
-        ``shape="WTE2"``: passes the quadratic patch test;
+        ``"VC2"`` (second-order VC for ``shape="WTE2"``: PBG with V4
+        correction functions, PPG1 (5.24) with V1 ones on its test
+        derivatives; passes the quadratic patch test;
         :mod:`skfem_pg.vc2`).
     method
         ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
@@ -196,17 +197,17 @@ class FamilyBasis(AbstractBasis):
         if vc == "auto":
             vc = {"MTE1": "V5" if bond and not ppg else "V3",
                   "WTE2": "V3"}.get(shape)
-        if vc == "VC2" and (shape != "WTE2" or ppg):
+        if vc == "VC2" and (shape != "WTE2" or method == "PPG2"):
             raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
-                             "trial basis of PBG: shape='WTE2', "
-                             "method='PBG'")
+                             "trial basis: shape='WTE2', method='PBG' or "
+                             "'PPG1'")
         if test_shape not in TEST_SHAPES:
             raise ValueError("test_shape must be one of {}, got {!r}".format(
                 ", ".join(TEST_SHAPES), test_shape))
         if test_shape != "master" and not ppg:
             raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
                              "use method='PPG1' or 'PPG2'".format(test_shape))
-        allowed = (("V1", "V2", "V3", "V4") if ppg
+        allowed = (("V1", "V2", "V3", "V4", "VC2") if ppg
                    else ("V2", "V3", "V4", "V5", "VC2"))
         if vc is not None and vc not in allowed:
             raise ValueError("vc={!r} is not available for {}: use one of {} "
@@ -286,9 +287,23 @@ class FamilyBasis(AbstractBasis):
             if area_vectors.shape != x.shape:
                 raise ValueError("area_vectors must have shape {}, got {}"
                                  .format(x.shape, area_vectors.shape))
-            phi = correction_functions(vc, x, V, families,
-                                       n=weight_exponent)
-            if vc == "VC2":
+            # VC2 of PPG1 corrects test functions only: V1 functions
+            # (the thesis' VC2PPG V1s U2); of PBG, V4 (keeps the trial's
+            # quadratic consistency)
+            phi = correction_functions("V1" if vc == "VC2" and ppg else vc,
+                                       x, V, families, n=weight_exponent)
+            if vc == "VC2" and ppg:
+                warnings.warn(
+                    "VC2 PPG1 (VC2PPG V1 U2) passes the quadratic patch "
+                    "test but is unstable here: its free tangent has "
+                    "eigenvalues with negative real part (40 on a regular "
+                    "20x10 block, 214 distorted) and it does not converge "
+                    "on a manufactured solution; prefer PBG's VC2")
+                Gt, self.vc_report = vc2_correction(
+                    Gt, dx_t, x, V, families, area_vectors,
+                    particles.area_moments(), phi, exclude=vc_exclude,
+                    boundary=vc_boundary, method="PPG1")
+            elif vc == "VC2":
                 G, self.vc_report = vc2_correction(
                     G, self.dx, x, V, families, area_vectors,
                     particles.area_moments(), phi, exclude=vc_exclude,

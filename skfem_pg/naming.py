@@ -50,9 +50,10 @@ def parse(name):
         kw["vc"] = None
     elif g["vc"] == "VC2":
         kw["vc"] = "VC2"
-        if g["variant"] not in (None, "V4"):
-            notes.append("VC2 uses the V4 correction functions here, not {}"
-                         .format(g["variant"]))
+        own = "V4" if method == "PBG" else "V1"
+        if g["variant"] not in (None, own):
+            notes.append("VC2 {} uses the {} correction functions here, not "
+                         "{}".format(method, own, g["variant"]))
     else:
         kw["vc"] = g["variant"] or ("V5" if g["bc"] and method == "PBG"
                                     else "V3")
@@ -71,7 +72,10 @@ def name_of(basis):
         ("BC" if basis.bond else "")
     method = {"PPG1": "PPG"}.get(basis.method, basis.method)
     form = {v: k for k, v in SHAPES.items()}[basis.shape]
-    variant = " V4" if vc == "VC2" else (" " + vc if vc else "")
+    if vc == "VC2":
+        variant = " V4" if basis.method == "PBG" else " V1"
+    else:
+        variant = " " + vc if vc else ""
     if vc and basis.vc_boundary != "min-norm":
         variant += basis.vc_boundary
     return "{}{}{} {}".format(prefix, method, variant, form)

@@ -100,10 +100,52 @@ def _system(phi, dx, fam, X, h):
     M[..., 0, 1:] = m1[:, None, :]
     M[..., 1:, 0] = m1[:, None, :] + Vk[:, None, None] * rel
     M[..., 1:, 1:] = m2[:, None] + rel[..., :, None] * m1[:, None, None, :]
-    vals = phi[..., None, None] * M  # (k, i, r, s)
+    return _blocks_to_csr(phi[..., None, None] * M, fam, d)
+
+
+def ppg1_second_order_functions(phi, fam, X, h):
+    r"""``(nf, m, d)`` functions :math:`\psi^{ki} = \varphi^{ki}\Delta
+    X^{ki} - \delta_{ki}\sum_l\varphi^{kl}\Delta X^{kl}` (lengths scaled
+    by ``h``) that carry the second-order unknowns of PPG1: they sum to
+    zero over ``i``, so the corrected test derivatives keep
+    :math:`\sum_i G_t^{ki} = 0`, without which the element view of PPG1
+    (bond pairs, :func:`skfem_pg.petrov.element_test_gradients`) would not
+    have the constraints (5.16), (5.24) of the master view."""
+    mem, mask = fam.padded()
+    P = (X / h).T[mem]
+    psi = phi[..., None] * (P - P[:, :1]) * mask[..., None]
+    psi[:, 0] -= psi.sum(axis=1)
+    return psi
+
+
+def _system_ppg1(phi, Vk, fam, X, h):
+    r"""Scalar matrix of the PPG1 VC2 system (5.24): test derivatives at
+    the masters only, :math:`G_t^{ki}_B \mathrel{+}= \varphi^{ki}\alpha^k_B
+    + \psi^{ki}_e\beta^k_{eB}` (:func:`ppg1_second_order_functions`);
+    block :math:`V^k\,(1, -\Delta X^{ki})\otimes(\varphi^{ki},
+    \psi^{ki})` (rows ``(i, r)``, columns ``(k, s)``, lengths scaled by
+    ``h``)."""
+    mem, mask = fam.padded()
+    nf, m = mem.shape
+    d = X.shape[0]
+    P = (X / h).T[mem]
+    dX = (P - P[:, :1]) * mask[..., None]  # ΔX^{ki}, (k, i, c)
+    left = np.concatenate([np.ones((nf, m, 1)), -dX], axis=-1)
+    right = np.concatenate([phi[..., None],
+                            ppg1_second_order_functions(phi, fam, X, h)],
+                           axis=-1)
+    M = Vk[:, None, None, None] * left[..., :, None] * right[..., None, :]
+    return _blocks_to_csr(M * mask[..., None, None], fam, d)
+
+
+def _blocks_to_csr(M, fam, d):
+    """``(nf, m, d+1, d+1)`` blocks ``(k, i)`` → sparse rows ``(i, r)``,
+    columns ``(k, s)``."""
+    mem, mask = fam.padded()
+    nf, m = mem.shape
     k = np.broadcast_to(np.arange(nf)[:, None], (nf, m))[mask]
     i = mem[mask]
-    vals = vals[mask]
+    vals = M[mask]
     r = np.arange(d + 1)
     rows = (d + 1) * i[:, None, None] + r[None, :, None]
     cols = (d + 1) * k[:, None, None] + r[None, None, :]
@@ -113,13 +155,20 @@ def _system(phi, dx, fam, X, h):
 
 
 def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
-                   tol=1e-15, maxiter=None, boundary="min-norm"):
+                   tol=1e-15, maxiter=None, boundary="min-norm",
+                   method="PBG"):
     """Second-order VC correction of PBG derivatives ``G`` (quadratic
     consistent, e.g. WTE2); ``area`` :math:`A^i` ``(d, n)``, ``area2``
-    :math:`A_2^i` ``(d, d, n)`` about the origin 0, ``phi`` the V4
-    correction function ``(nf, m)``; ``boundary`` ``"min-norm"`` (LSQR)
-    or ``"s"`` (sparse LU).  Returns ``(G_corrected, VCReport)``.
+    :math:`A_2^i` ``(d, d, n)`` about the origin 0, ``phi`` the correction
+    function ``(nf, m)`` (V4; for PPG1 also V1/V3); ``boundary``
+    ``"min-norm"`` (LSQR) or ``"s"`` (sparse LU).  ``method="PPG1"``
+    corrects PPG1 test derivatives instead (``G`` nonzero at ``j = 0``
+    only, ``dx`` the master weights): constraint (5.24), ansatz of
+    :func:`_system_ppg1`.  Returns ``(G_corrected, VCReport)``.
     """
+    if method not in ("PBG", "PPG1"):
+        raise ValueError("VC2 is implemented for PBG and PPG1, not {!r}"
+                         .format(method))
     if boundary not in ("min-norm", "s"):
         raise ValueError("VC2 boundary variant {!r} is not available: "
                          "'min-norm' or 's'".format(boundary))
@@ -132,7 +181,8 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
     active = volumes > 0
     h = np.mean(volumes[active]) ** (1.0 / d)
     r1, r2 = vc2_residuals(G, dx, fam, x, volumes, area, area2)
-    A = _system(phi, dx, fam, x, h)
+    A = (_system(phi, dx, fam, x, h) if method == "PBG"
+         else _system_ppg1(phi, dx[:, 0], fam, x, h))
     # right-hand sides per component B: rows (i, 0) r1, (i, c) r2 / h
     rhs = -np.concatenate([r1[:, None, :], r2 / h], axis=1)  # (n, 1+d, B)
     keep = active.copy()
@@ -173,12 +223,21 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
     # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
     corr = alpha[:, None, 0, :] + np.einsum("kjc,kcB->kjB", dX,
                                             alpha[:, 1:, :])
-    Gc = G + phi[:, None, :, None] * (corr * mask[..., None])[:, :, None, :]
+    if method == "PBG":
+        Gc = G + phi[:, None, :, None] * (corr * mask[..., None])[:, :, None,
+                                                                  :]
+    else:  # PPG1: at the masters, functions of the test member i
+        psi = ppg1_second_order_functions(phi, fam, x, h)
+        Gc = G.copy()
+        Gc[:, 0] += (phi[..., None] * alpha[:, None, 0, :]
+                     + np.einsum("kie,keB->kiB", psi, alpha[:, 1:, :])) \
+            * mask[..., None]
     s1, s2 = vc2_residuals(Gc, dx, fam, x, volumes, area, area2)
     scale = h ** (d - 1)
     before = max(np.abs(r1[keep]).max(), np.abs(r2[keep]).max() / h)
     after = max(np.abs(s1[keep]).max(), np.abs(s2[keep]).max() / h)
-    rep = VCReport(variant="VC2 (V4)", solver=solver,
+    rep = VCReport(variant="VC2" if method == "PBG" else "VC2 (PPG1)",
+                   solver=solver,
                    unknowns=(d + 1) * d * (len(cols) if boundary == "s"
                                            else len(fam)),
                    constraints=(d + 1) * d * int(keep.sum()),

@@ -15,6 +15,8 @@ from conftest import square
                              vc="V5", vc_boundary="p")),
     ("VC2PBG V4 U2", dict(shape="WTE2", method="PBG", bond=False,
                           vc="VC2")),
+    ("VC2PPG V1s U2", dict(shape="WTE2", method="PPG1", bond=False,
+                           vc="VC2", vc_boundary="s")),
     ("VCBCPPG Unl", dict(shape="MTE1", method="PPG1", bond=True, vc="V3")),
 ])
 def test_parse(name, expected):

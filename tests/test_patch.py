@@ -140,3 +140,42 @@ def test_vc_names_and_supports_are_checked():
         pg.FamilyBasis(m, dim=2, vc="V1")  # PBG: V1 breaks the trial
     with pytest.raises(pg.FamilyError, match="at least 7"):
         pg.FamilyBasis(m, dim=2, vc="V4")  # WLS2 on FE-connectivity
+
+
+def test_vc2_ppg_v1s_u2_passes_the_quadratic_patch_test():
+    """The thesis' passing row of Table 7.3, VC2PPG V1s U2: second-order
+    VC of the PPG1 test derivatives (5.24) with V1 functions, surface
+    correction fixed (``s``): one sparse LU."""
+    from skfem_pg.analysis import quadratic_patch_test
+    m, top, _ = quadratic_case()
+    with pytest.warns(UserWarning, match="unstable"):
+        r = quadratic_patch_test(m, top, shape="WTE2", method="PPG1",
+                                 vc="VC2", vc_boundary="s")
+    assert r["max_error"] <= 1e-10  # measured 1.7e-12
+    assert r["basis"].name == "VC2PPG V1s U2"
+    assert r["basis"].vc_report.solver == "direct"
+    # unlike PBG's VC2 (V4), the full PPG1 system is compatible: LSQR
+    # reaches the constraints without excluding particles (its tolerance
+    # limits the patch test to 2.2e-10 here)
+    with pytest.warns(UserWarning, match="unstable"):
+        r_all = quadratic_patch_test(m, top, shape="WTE2", method="PPG1",
+                                     vc="VC2")
+    assert r_all["basis"].vc_report.residual_after < 1e-8
+    # the warning is earned: negative-real eigenvalues of the free tangent
+    from skfem_pg.spectrum import free_modes
+    from skfem_pg.models import lame, linear_elasticity
+    b = r["basis"]
+    K = pg.assemble(linear_elasticity(*lame(1.0, 0.4)), b)
+    lam = np.asarray(free_modes(K, np.repeat(b.particles.volumes, 2))[
+        "eigenvalues"]).real
+    assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
+    # the constraints hold in the bond-pair (element) view that assembles
+    # PPG1, not only in the master view they were solved in
+    from skfem_pg.vc2 import vc2_residuals
+    b = r["basis"]
+    p = b.particles
+    r1, r2 = vc2_residuals(b.test.G, b.dx, b.families, p.x, p.volumes,
+                           p.area_vectors(), p.area_moments())
+    inner = np.setdiff1d(np.arange(p.n), m.boundary_nodes())
+    assert np.abs(r1[inner]).max() < 1e-10
+    assert np.abs(r2[inner]).max() < 1e-10
