@@ -72,8 +72,7 @@ def master_fits(x, volumes, fam, n=1, order=1, moving=False):
     nf, m = mem_all.shape
     d = x.shape[0]
     need = d + 1 if order == 1 else 1 + d + d * (d + 1) // 2
-    nb = need
-    c = np.zeros((nf, m, nb))
+    c = np.zeros((nf, m, need))
     h = np.ones(nf)
     grad = np.zeros((nf, m, d)) if moving else None
     for sl in chunks(nf, m * m):
