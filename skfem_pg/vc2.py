@@ -193,21 +193,16 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
         surf, _, _ = vc_boundary.surface_frames(area)
         keep[surf] = False
         cols = np.nonzero(keep[fam.masters])[0]
-        K = A[np.repeat(keep, d + 1)][:, (
-            (d + 1) * cols[:, None] + np.arange(d + 1)).ravel()].tocsc()
-        if K.shape[0] != K.shape[1]:
-            raise ValueError("VC2 boundary 's' needs one family per "
-                             "particle ({} equations, {} unknowns)"
-                             .format(*K.shape))
-        rhs = rhs[keep].reshape(-1, d)
+        # select the kept equations and unknowns; one LU (vc_boundary)
+        R = sp.eye((d + 1) * n, format="csr")[np.repeat(keep, d + 1)]
+        T = sp.eye((d + 1) * len(fam), format="csc")[:, (
+            (d + 1) * cols[:, None] + np.arange(d + 1)).ravel()]
         try:
-            lu = spl.splu(K, permc_spec="COLAMD")
+            sol = vc_boundary.solve_reduced(A, rhs.reshape(-1, d), R, T)
         except RuntimeError as err:
-            raise RuntimeError("the VC2 system with boundary 's' is "
-                               "singular ({})".format(err)) from None
-        sol = lu.solve(rhs)
-        sol += lu.solve(rhs - K @ sol)
-        alpha[cols] = sol.reshape(len(cols), d + 1, d)
+            raise RuntimeError("VC2 with boundary variant 's': {}"
+                               .format(err)) from None
+        alpha = sol.reshape(len(fam), d + 1, d)
         its, solver = 2, "direct"
     else:
         A = A[np.repeat(keep, d + 1)]
@@ -218,12 +213,12 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
                            conlim=1e12, iter_lim=maxiter or 50 * A.shape[1])
             alpha[:, :, b] = sol[0].reshape(-1, d + 1)
             its = max(its, sol[2])
-    P = (x / h).T[mem]
-    dX = (P - P[:, :1]) * mask[..., None]  # (k, j, c) scaled
-    # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
-    corr = alpha[:, None, 0, :] + np.einsum("kjc,kcB->kjB", dX,
-                                            alpha[:, 1:, :])
     if method == "PBG":
+        P = (x / h).T[mem]
+        dX = (P - P[:, :1]) * mask[..., None]  # (k, j, c) scaled
+        # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
+        corr = alpha[:, None, 0, :] + np.einsum("kjc,kcB->kjB", dX,
+                                                alpha[:, 1:, :])
         Gc = G + phi[:, None, :, None] * (corr * mask[..., None])[:, :, None,
                                                                   :]
     else:  # PPG1: at the masters, functions of the test member i
