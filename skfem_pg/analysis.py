@@ -49,6 +49,58 @@ def h1_error(basis, u, exact_grad):
         pbg_weights(basis.particles.volumes, basis.families) * err)))
 
 
+def nodal_interpolant(basis, field):
+    """Nodal vector of ``field(x)`` (``(ncomp, n)`` values at points ``x``
+    of shape ``(dim, n)``) at the particles of a family basis or at the
+    vertices of a scikit-fem P1/Q1 vector basis."""
+    family = isinstance(basis, FamilyBasis)
+    x = basis.particles.x if family else basis.mesh.p
+    if family:
+        nc = 1 if basis.ncomp is None else basis.ncomp
+    else:
+        nc = basis.nodal_dofs.shape[0]
+        if nc * x.shape[1] != basis.N:
+            raise ValueError("nodal_interpolant needs a vertex-only FE "
+                             "basis (P1/Q1), this one has {} dofs for {} "
+                             "vertices".format(basis.N, x.shape[1]))
+    values = np.asarray(field(x), float)
+    if values.shape != (nc, x.shape[1]) and not (
+            nc == 1 and values.shape == (x.shape[1],)):
+        raise ValueError("field(x) must return shape ({}, {}), got {}"
+                         .format(nc, x.shape[1], values.shape))
+    values = values.reshape(nc, -1)
+    if family:
+        return values.T.ravel()
+    u = np.zeros(basis.N)
+    u[basis.nodal_dofs] = values
+    return u
+
+
+def discrete_energy(basis, u, material):
+    r"""Strain energy of the nodal vector ``u`` as the discretization
+    integrates it, :math:`\sum_k\sum_j w_{kj} W(F^{kj})` for a family
+    basis (PBG weights (4.30); PPG bases use their own ``dx``) and
+    :math:`\sum_e\sum_q w_{eq} W(F)` for a scikit-fem vector basis."""
+    d = basis.mesh.dim() if hasattr(basis, "mesh") else basis.particles.dim
+    F = basis.interpolate(u).grad + np.eye(d).reshape(d, d, 1, 1)
+    return float(np.sum(basis.dx * material.energy(F)))
+
+
+def energy_capture(basis, field, material, exact_energy):
+    r"""Ratio of the discrete strain energy of the nodal interpolant of
+    ``field`` to ``exact_energy`` (:math:`\int_\Omega W`).
+
+    A quadrature-and-gradient consistency check that needs no solve: a
+    linear field gives 1 to round-off on every linearly consistent
+    discretization; a bending field shows how much of its energy a
+    discretization sees — below 1 means too soft in that mode, above 1
+    too stiff (locking).  ``benchmarks/bending_3d.py`` uses it to explain
+    the 3-D Cook's membrane results.
+    """
+    return discrete_energy(basis, nodal_interpolant(basis, field),
+                           material) / float(exact_energy)
+
+
 def linear_patch_test(mesh, neumann, gradient=None, E=100.0, nu=0.3,
                       particles=None, **basis_kwargs):
     """Linear patch test (thesis (7.1)–(7.2)) on ``mesh``.
