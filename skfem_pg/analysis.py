@@ -81,7 +81,8 @@ def discrete_energy(basis, u, material):
     integrates it, :math:`\sum_k\sum_j w_{kj} W(F^{kj})` for a family
     basis (PBG weights (4.30); PPG bases use their own ``dx``) and
     :math:`\sum_e\sum_q w_{eq} W(F)` for a scikit-fem vector basis."""
-    d = basis.mesh.dim() if hasattr(basis, "mesh") else basis.particles.dim
+    d = basis.particles.dim if isinstance(basis, FamilyBasis) \
+        else basis.mesh.dim()
     F = basis.interpolate(u).grad + np.eye(d).reshape(d, d, 1, 1)
     return float(np.sum(basis.dx * material.energy(F)))
 
