@@ -10,17 +10,20 @@ scikit-fem's own assembly, so the same ``BilinearForm`` assembles FE and PG.
 True
 """
 from . import families, shape, corrections, meshing, materials, solvers, models
-from .errors import ParticleError, FamilyError, UnsupportedMeshError
+from .errors import (ParticleError, FamilyError, UnsupportedMeshError,
+                     SlowAssemblyWarning)
 from .particles import Particles
 from .families import Families
 from .basis import FamilyBasis
 from .assembly import assemble, block_pattern
+from .forms import BilinearForm, LinearForm
 from .loads import traction, stress_load, body_force
 from .io import write_vtu
 
 __version__ = "0.1.0"
 
 __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
+           "BilinearForm", "LinearForm", "SlowAssemblyWarning",
            "block_pattern", "traction", "stress_load", "body_force",
            "write_vtu", "families", "shape", "corrections", "meshing",
            "materials", "solvers", "models",

