@@ -10,8 +10,8 @@ scikit-fem's own assembly, so the same ``BilinearForm`` assembles FE and PG.
 True
 """
 from . import families, shape, corrections, meshing, materials, solvers, models
-from .errors import (ParticleError, FamilyError, UnsupportedMeshError,
-                     SlowAssemblyWarning)
+from .errors import (ParticleError, FamilyError, CorrectionError,
+                     UnsupportedMeshError, SlowAssemblyWarning)
 from .particles import Particles
 from .families import Families
 from .basis import FamilyBasis
@@ -27,4 +27,5 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "block_pattern", "traction", "stress_load", "body_force",
            "write_vtu", "families", "shape", "corrections", "meshing",
            "materials", "solvers", "models",
-           "ParticleError", "FamilyError", "UnsupportedMeshError"]
+           "ParticleError", "FamilyError", "CorrectionError",
+           "UnsupportedMeshError"]

@@ -41,7 +41,8 @@ from skfem.element import DiscreteField
 
 from . import families as families_mod
 from . import petrov
-from .corrections import bond_correction, correction_functions, vc_correction
+from .corrections import (bond_correction, check_correction,
+                          correction_functions, vc_correction)
 from .errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
@@ -139,6 +140,14 @@ class FamilyBasis(AbstractBasis):
         ``basis.area_correction``, which the loads of
         :mod:`skfem_pg.loads` include.
 
+    vc_tolerance
+        Largest accepted constraint residual after the VC correction,
+        relative to :math:`h^{d-1}` (default 1e-8: the patch test holds
+        to about 1e-10).  Above it, and for non-finite or blown-up
+        derivatives (:data:`~skfem_pg.corrections.GRADIENT_LIMIT`), the
+        basis raises :class:`~skfem_pg.errors.CorrectionError` naming the
+        worst particles.  ``None`` keeps an inexact correction with a
+        warning (studies of the incompatible V2/V4/VC2 systems).
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
         basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
@@ -175,7 +184,8 @@ class FamilyBasis(AbstractBasis):
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
-                 test_shape="master", lme_mu=1.8, vc_boundary="min-norm"):
+                 test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
+                 vc_tolerance=1e-8):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -258,6 +268,8 @@ class FamilyBasis(AbstractBasis):
             t0 = time.perf_counter()
             G = bond_correction(G, x, families)
             self.timings["bond"] = time.perf_counter() - t0
+        if vc is None:
+            check_correction(G, x, families, None, what=shape)
 
         mem, mask = families.padded()
         Vm = V[mem] * mask
@@ -330,6 +342,12 @@ class FamilyBasis(AbstractBasis):
                     variant=vc, solver=vc_solver, exclude=vc_exclude,
                     boundary=vc_boundary)
             self.timings["vc"] = time.perf_counter() - t0
+        check_correction(Gt if ppg else G, x, families, self.vc_report,
+                         vc_tolerance, what="VC {} ({}{})".format(
+                             vc, method, "" if vc_boundary == "min-norm"
+                             else ", boundary " + vc_boundary))
+        if ppg:
+            check_correction(G, x, families, None, what=shape + " trial")
         self.G = G
         self.test = None
         self.area_correction = (None if self.vc_report is None

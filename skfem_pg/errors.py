@@ -14,6 +14,12 @@ class FamilyError(ValueError):
     coplanar members; singular moment matrix)."""
 
 
+class CorrectionError(FamilyError):
+    """A bond or VC correction cannot be computed accurately for these
+    families (constraint residual above round-off, blown-up or non-finite
+    derivatives)."""
+
+
 class UnsupportedMeshError(TypeError):
     """The mesh type is not a linear scikit-fem mesh (tri, quad, tet, hex)."""
 

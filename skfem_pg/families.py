@@ -229,14 +229,30 @@ def horizon(particles, delta=None, factor=1.51, min_size=None):
 
     ``delta`` defaults to ``factor`` times the mean nearest-neighbour
     distance ``h`` (the grid spacing of a regular node set; thesis:
-    1.51 h ... 3.01 h).
+    1.51 h ... 3.01 h).  A non-finite or non-positive ``delta`` or
+    ``factor``, or a ``delta`` below the median nearest-neighbour distance
+    (most families would hold the master alone), raises
+    :class:`FamilyError`; the few particles a valid horizon leaves without
+    enough neighbours get the next ring (module docstring).
     """
     act, tree = _active_tree(particles)
+    dist, _ = tree.query(particles.x[:, act].T, k=2)
+    spacing = dist[:, 1]
     if delta is None:
-        dist, _ = tree.query(particles.x[:, act].T, k=2)
-        delta = factor * float(np.mean(dist[:, 1]))
-    if delta <= 0:
-        raise FamilyError("the horizon must be positive, got {}".format(delta))
+        factor = _positive_number(factor, "horizon factor")
+        delta = factor * float(np.mean(spacing))
+    delta = _positive_number(delta, "horizon delta")
+    if delta < np.median(spacing):  # most families would be the master
+        lonely = np.nonzero(spacing > delta)[0]
+        q = act[lonely[np.argmax(spacing[lonely])]]
+        raise FamilyError(
+            "the horizon delta = {:.6g} is below the median nearest-"
+            "neighbour distance {:.6g}: {} of {} particles have no "
+            "neighbour within it, e.g. {} (nearest at {:.6g}); use a delta "
+            "of 1.51 ... 3.01 times the mean spacing {:.6g} (factor=)"
+            .format(delta, np.median(spacing), len(lonely), len(act),
+                    describe_particle(q, particles.x[:, q]),
+                    spacing[lonely].max(), np.mean(spacing)))
     pairs = tree.query_pairs(r=delta, output_type="ndarray")
     i, j = act[pairs[:, 0]], act[pairs[:, 1]]
     n = particles.n
@@ -251,6 +267,10 @@ def nearest(particles, n, pairwise=True, min_size=None):
     """Families of the ``n`` nearest neighbours of each particle, made
     pairwise (``j`` in ``H^k`` whenever ``k`` in ``H^j``) by default."""
     act, tree = _active_tree(particles)
+    if isinstance(n, (bool, np.bool_)) or not isinstance(
+            n, (int, np.integer)):
+        raise FamilyError("the number of neighbours n must be an integer, "
+                          "got {!r}".format(n))
     if n < 1 or n >= len(act):
         raise FamilyError("need 1 <= n < {} (active particles), got {}"
                           .format(len(act), n))
@@ -265,6 +285,18 @@ def nearest(particles, n, pairwise=True, min_size=None):
     d = particles.dim
     return _complete(particles.x, A, act,
                      d + 2 if min_size is None else min_size)
+
+
+def _positive_number(value, what):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise FamilyError("the {} must be a number, got {!r}".format(
+            what, value)) from None
+    if not np.isfinite(v) or v <= 0:
+        raise FamilyError("the {} must be positive and finite, got {!r}"
+                          .format(what, value))
+    return v
 
 
 def check_supports(particles, families, n_required, what):

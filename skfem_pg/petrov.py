@@ -166,5 +166,7 @@ def ppg2_vc_correction(Gt, volumes, fam, area, phi, exclude=None, tol=1e-15,
                                          / h ** (d - 1)),
                    residual_after=float(np.abs(r1[keep]).max()
                                         / h ** (d - 1)),
-                   iterations=its, seconds=time.perf_counter() - t0)
+                   iterations=its, seconds=time.perf_counter() - t0,
+                   particle_residuals=np.abs(r1).max(axis=1) * keep
+                   / h ** (d - 1))
     return Gc, rep

@@ -44,7 +44,6 @@ one sparse LU.  The surface particles' discrete :math:`A^i` and
 :math:`A^i`, :math:`A_2^i`).
 """
 import time
-import warnings
 
 import numpy as np
 import scipy.sparse as sp
@@ -238,16 +237,18 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
                    constraints=(d + 1) * d * int(keep.sum()),
                    residual_before=float(before / scale),
                    residual_after=float(after / scale), iterations=int(its),
-                   seconds=time.perf_counter() - t0, boundary=boundary)
+                   seconds=time.perf_counter() - t0, boundary=boundary,
+                   particle_residuals=np.maximum(
+                       np.abs(s1).max(axis=1),
+                       np.abs(s2).reshape(len(s2), -1).max(axis=1) / h)
+                   * keep / scale)
     if boundary == "s":
         rep.area_correction = s1.T.copy()
         # r2 = S2 - X⊗S1 - (A2 - X⊗A) + V I: discrete minus FE A2 is
         # r2 + X⊗r1, stored as (d, d, n) like A2
         rep.area2_correction = np.moveaxis(
             s2 + x.T[:, :, None] * s1[:, None, :], 0, -1).copy()
-    if rep.residual_after > 1e-8:
-        warnings.warn("VC2 left a constraint residual of {:.2e} (relative "
-                      "to h^(d-1)); the full second-order system is "
-                      "incompatible: pass the Dirichlet particles as "
-                      "vc_exclude".format(rep.residual_after))
+    if exclude is None and boundary != "s":
+        rep.notes.append("the full second-order system is incompatible: "
+                         "pass the Dirichlet particles as vc_exclude")
     return Gc, rep

@@ -109,7 +109,10 @@ def test_vc_falls_back_to_lsqr_when_a_particle_masters_no_family():
                       np.concatenate([fam.members[fam.offsets[k]:
                                                   fam.offsets[k + 1]]
                                       for k in keep]), p.n)
+    # the LSQR fallback leaves a residual of 1.2e-2: refused by default
+    with pytest.raises(pg.CorrectionError, match="particle 20"):
+        pg.FamilyBasis(p, sub, dim=2)
     with pytest.warns(UserWarning, match="constraint residual"):
-        b = pg.FamilyBasis(p, sub, dim=2)
+        b = pg.FamilyBasis(p, sub, dim=2, vc_tolerance=None)
     assert b.vc_report.solver == "lsqr"
     assert "fell back to LSQR" in b.vc_report.notes[0]

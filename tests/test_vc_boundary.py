@@ -137,9 +137,13 @@ def test_v2_passes_with_released_surface_constraints(mesh, boundary):
                               vc_boundary=boundary)
         assert r["max_error"] <= 1e-10  # measured <= 9.4e-14
     if boundary == "s":
+        with pytest.raises(pg.CorrectionError,
+                           match="vc_boundary='s' or 'sn'"):
+            linear_patch_test(mesh, TOP[d], particles=p, families=fam,
+                              bond=False, vc="V2")
         with pytest.warns(UserWarning, match="vc_boundary='s' or 'sn'"):
             r = linear_patch_test(mesh, TOP[d], particles=p, families=fam,
-                                  bond=False, vc="V2")
+                                  bond=False, vc="V2", vc_tolerance=None)
         assert r["max_error"] > 1e-6
 
 
