@@ -190,13 +190,28 @@ class ProbeError(TypeError):
 
 def _call(form, *args):
     try:
-        return form.form(*args)
+        out = form.form(*args)
     except (TypeError, AttributeError, ValueError) as err:
         raise ProbeError(
             "skfem_pg.assemble probes '{}' with value/gradient fields only "
             "and the form needs more ({}); assemble it with "
             "form.assemble(basis) instead".format(form.form.__name__, err)) \
             from err
+    nd = np.ndim(out)
+    if nd not in (0, 2):
+        field = args[0]
+        scalar = np.ndim(field) == 2
+        raise ValueError(
+            "form '{}' returned an array of shape {} for one pair of {} "
+            "basis functions, where one value per (element, quadrature "
+            "point) is expected: the form is written for {} fields. {}"
+            .format(form.form.__name__, np.shape(out),
+                    "scalar" if scalar else "vector",
+                    "vector" if scalar else "scalar (or other-dimensional)",
+                    "Build the basis with dim= the number of components "
+                    "(e.g. FamilyBasis(..., dim=2) for 2-D displacements)"
+                    if scalar else "Check the basis' dim against the form"))
+    return out
 
 
 def block_pattern(basis, view=None):

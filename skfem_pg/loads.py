@@ -41,6 +41,8 @@ def traction(basis, facets, t):
     """
     fb = _facet_basis(basis, facets, "traction")
     vector = basis.ncomp is not None
+    if not callable(t):
+        t = _constant(t, basis, "traction t")
 
     @fem.LinearForm
     def load(v, w):
@@ -71,7 +73,14 @@ def traction(basis, facets, t):
 def stress_load(basis, facets, P):
     r"""Nodal forces :math:`\bar P \cdot A^i_\Gamma` of a homogeneous nominal
     stress ``P`` (``(d, d)``) acting on ``facets``."""
+    d = basis.particles.dim
     P = np.asarray(P, dtype=float)
+    if basis.ncomp is None or P.shape != (d, d):
+        raise ValueError(
+            "stress_load needs a vector basis (dim={0}) and a ({0}, {0}) "
+            "nominal stress, got {1} and shape {2}".format(
+                d, "a scalar basis" if basis.ncomp is None else
+                "dim={}".format(basis.ncomp), P.shape))
     A = basis.particles.area_vectors(facets)
     dA = _area_correction(basis, facets)
     f = P @ (A if dA is None else A + dA)  # (d, np)
@@ -97,13 +106,44 @@ def _area_correction(basis, facets):
 def body_force(basis, b, rho=1.0):
     r"""Nodal forces :math:`\rho_0 b(X^i) V^i` of a body force ``b``
     (constant vector or callable of positions ``(dim, n)``)."""
+    if not hasattr(basis, "particles"):
+        raise TypeError(
+            "body_force lumps b V^i on particles; for a scikit-fem basis "
+            "assemble the consistent load instead, e.g. "
+            "LinearForm(lambda v, w: dot(b, v)).assemble(basis)")
     x, V = basis.particles.x, basis.particles.volumes
-    bv = b(x) if callable(b) else np.asarray(b, dtype=float)
+    n = len(V)
+    nc = 1 if basis.ncomp is None else basis.ncomp
+    bv = np.asarray(b(x) if callable(b) else b, dtype=float)
+    if callable(b):
+        shapes = [(nc, n)] if nc > 1 else [(n,), (1, n)]
+    else:
+        shapes = [(nc,)] if nc > 1 else [(), (1,)]
+    if bv.shape not in shapes:
+        raise ValueError(
+            "body force b must be {} (or a callable of x returning shape "
+            "{}), got shape {}".format(
+                "a scalar" if nc == 1 else "a vector of length {}".format(nc),
+                (nc, n) if nc > 1 else (n,), bv.shape))
     if basis.ncomp is None:
-        return rho * np.broadcast_to(bv, V.shape) * V
-    bv = np.broadcast_to(np.asarray(bv).reshape(basis.ncomp, -1),
-                         (basis.ncomp, len(V)))
+        return rho * np.broadcast_to(bv.reshape(-1), V.shape) * V
+    bv = np.broadcast_to(bv.reshape(nc, -1), (nc, n))
     return (rho * bv * V).T.ravel()
+
+
+def _constant(t, basis, what):
+    """A constant load as a float array of the basis' component count."""
+    t = np.asarray(t, dtype=float)
+    nc = basis.ncomp
+    if nc is None:
+        if t.size != 1:
+            raise ValueError("{} on a scalar basis must be a scalar, got "
+                             "shape {}".format(what, t.shape))
+        return float(t.ravel()[0])
+    if t.shape != (nc,):
+        raise ValueError("{} must have {} components for this dim={} "
+                         "basis, got shape {}".format(what, nc, nc, t.shape))
+    return t
 
 
 def _resize(f, basis):

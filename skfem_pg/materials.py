@@ -13,6 +13,8 @@ Tangents are verified against central finite differences in
 """
 import numpy as np
 
+from .models import check_moduli
+
 
 def inverse_and_det(F):
     """Inverse and determinant of ``(d, d, ...)`` arrays."""
@@ -67,6 +69,7 @@ class LinearElastic(Material):
     :math:`P = \lambda\,\mathrm{tr}\varepsilon\, I + 2\mu\varepsilon`."""
 
     def __init__(self, lam, mu, plane_stress=False):
+        lam, mu = check_moduli(lam=lam, mu=mu)
         if plane_stress:
             lam = 2 * lam * mu / (lam + 2 * mu)
         self.lam, self.mu = float(lam), float(mu)
@@ -97,7 +100,7 @@ class StVenantKirchhoff(Material):
     2\mu E`, :math:`P = FS`."""
 
     def __init__(self, lam, mu):
-        self.lam, self.mu = float(lam), float(mu)
+        self.lam, self.mu = check_moduli(lam=lam, mu=mu)
 
     def _S(self, F):
         E = 0.5 * (np.einsum("kI...,kJ...->IJ...", F, F) - _eye(F))
@@ -131,7 +134,7 @@ class NeoHooke(Material):
     :math:`P = \mu(F - F^{-T}) + \frac\lambda2(J^2 - 1)F^{-T}`."""
 
     def __init__(self, lam, mu):
-        self.lam, self.mu = float(lam), float(mu)
+        self.lam, self.mu = check_moduli(lam=lam, mu=mu)
 
     def stress(self, F):
         Finv, J = inverse_and_det(F)
@@ -163,11 +166,19 @@ class NeoHookeIsoVol(Material):
     :math:`\mathrm{tr}\,b = \mathrm{tr}\,b_{2D} + 1`."""
 
     def __init__(self, mu, K):
-        self.mu, self.K = float(mu), float(K)
+        self.mu, self.K = check_moduli(mu=mu, K=K)
 
     @classmethod
     def from_lame(cls, lam, mu):
         return cls(mu, lam + 2.0 * mu / 3.0)
+
+    @classmethod
+    def isochoric(cls, mu):
+        """The isochoric part alone (``K = 0``), e.g. for a mean-dilatation
+        model that adds the volumetric part per element."""
+        m = cls(mu, 1.0)
+        m.K = 0.0
+        return m
 
     def stress(self, F):
         Finv, J = inverse_and_det(F)

@@ -119,7 +119,7 @@ class MeanDilatation(Hyperelastic):
         if hasattr(basis, "G"):
             raise ValueError("MeanDilatation is the FE comparator; for "
                              "particles use the UnlP0 formulation")
-        super().__init__(basis, NeoHookeIsoVol(mu, 0.0))
+        super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(K)
         self.material_full = NeoHookeIsoVol(mu, K)
         self._V = basis.dx.sum(axis=1)

@@ -129,12 +129,41 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     return solve
 
 
-def _as_dofs(D):
+def as_dofs(D, N):
+    """Prescribed dofs as a sorted, unique int array, checked against the
+    system size ``N``: a scikit-fem ``DofsView`` / ``Dofs``, or integer
+    indices; booleans, negative, non-integer and out-of-range entries
+    raise (``-1`` would silently address the last dof)."""
     if D is None:
         return np.zeros(0, dtype=np.int64)
     if hasattr(D, "flatten"):
-        return np.asarray(D.flatten(), dtype=np.int64)
-    return np.asarray(D, dtype=np.int64).ravel()
+        D = D.flatten()
+    D = np.asarray(D).ravel()
+    if D.size == 0:
+        return np.zeros(0, dtype=np.int64)
+    if D.dtype == bool:
+        raise ValueError("Dirichlet dofs must be indices, got a boolean "
+                         "array; use np.flatnonzero(mask)")
+    if not np.issubdtype(D.dtype, np.integer):
+        if not np.issubdtype(D.dtype, np.floating) or np.any(
+                D != np.round(D)):
+            raise ValueError("Dirichlet dofs must be integer indices, got "
+                             "{} values, e.g. {!r}".format(D.dtype, D[0]))
+    D = D.astype(np.int64)
+    bad = (D < 0) | (D >= N)
+    if np.any(bad):
+        raise ValueError("Dirichlet dofs must lie in 0..{} (the basis has {} "
+                         "dofs); got {} (negative indices are not "
+                         "accepted)".format(N - 1, N, D[bad][:5]))
+    return np.unique(D)
+
+
+def _vector(v, N, what):
+    v = np.asarray(v, dtype=float).ravel() if v is not None else None
+    if v is not None and v.shape != (N,):
+        raise ValueError("{} must have one entry per dof ({}), got {}"
+                         .format(what, N, v.shape[0]))
+    return v
 
 
 def _condensed_solver(kind, basis, I):
@@ -182,11 +211,11 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     """
     basis = model.basis
     N = basis.N
-    Dd = _as_dofs(D)
+    Dd = as_dofs(D, N)
     I = np.setdiff1d(np.arange(N), Dd)
-    f_ext = np.zeros(N) if f_ext is None else np.asarray(f_ext, float)
-    u_D = np.zeros(N) if u_D is None else np.asarray(u_D, float)
-    u = np.zeros(N) if u0 is None else np.array(u0, dtype=float)
+    f_ext = np.zeros(N) if f_ext is None else _vector(f_ext, N, "f_ext")
+    u_D = np.zeros(N) if u_D is None else _vector(u_D, N, "u_D")
+    u = np.zeros(N) if u0 is None else _vector(u0, N, "u0").copy()
     lin = _condensed_solver(solver, basis, I)
     lam, dlam = 0.0, 1.0 / steps
     prev = None  # (load, u) of the converged step before the last

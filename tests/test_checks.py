@@ -1,0 +1,88 @@
+"""Ordinary mistakes raise with a message instead of a plausible wrong
+number: moduli, load shapes, Dirichlet dofs, form dimensions."""
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg import materials as mat
+from skfem_pg.mechanics import Hyperelastic
+from skfem_pg.models import lame, linear_elasticity
+
+
+@pytest.mark.parametrize("E, nu, match", [
+    (-1.0, 0.3, "Young"), (0.0, 0.3, "Young"), (1.0, 0.5, "incompressible"),
+    (1.0, 0.7, r"\(-1, 0.5\)"), (1.0, -1.0, r"\(-1, 0.5\)"),
+    (np.nan, 0.3, "finite"), ("a", 0.3, "number")])
+def test_lame_rejects_non_physical_constants(E, nu, match):
+    with pytest.raises(ValueError, match=match):
+        lame(E, nu)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: mat.NeoHooke(1.0, -2.0), "shear"),
+    (lambda: mat.NeoHooke(-1.0, 1.0), "bulk"),
+    (lambda: mat.StVenantKirchhoff(1.0, 0.0), "shear"),
+    (lambda: mat.LinearElastic(np.inf, 1.0), "finite"),
+    (lambda: mat.NeoHookeIsoVol(1.0, 0.0), "bulk modulus K"),
+    (lambda: mat.NeoHookeIsoVol(-1.0, 1.0), "shear"),
+    (lambda: linear_elasticity(1.0, -1.0), "shear")])
+def test_materials_reject_non_physical_constants(make, match):
+    with pytest.raises(ValueError, match=match):
+        make()
+
+
+@pytest.fixture(scope="module")
+def square():
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5),
+                                    np.linspace(0, 1, 5))
+    return mesh, pg.FamilyBasis(mesh, dim=2)
+
+
+def test_loads_reject_wrong_shapes(square):
+    mesh, b = square
+    right = mesh.facets_satisfying(lambda x: x[0] == 1)
+    with pytest.raises(ValueError, match="2 components"):
+        pg.traction(b, right, [0.0, 1.0, 0.0])  # was silently dropped
+    with pytest.raises(ValueError, match=r"\(2, 2\)"):
+        pg.stress_load(b, right, np.ones((1, 2)))
+    with pytest.raises(ValueError, match="length 2"):
+        pg.body_force(b, [1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match="shape"):
+        pg.body_force(b, lambda x: x[:1])
+    with pytest.raises(TypeError, match="LinearForm"):
+        pg.body_force(fem.Basis(mesh, fem.ElementQuad1()), 1.0)
+    f = pg.traction(b, right, [0.0, 1.0])
+    assert f.shape == (b.N,) and f[1::2].sum() == pytest.approx(1.0)
+    assert pg.body_force(b, [0.0, 2.0])[1::2].sum() == pytest.approx(2.0)
+
+
+@pytest.mark.parametrize("D, match", [
+    (np.array([0, 1, -1]), "negative"), (np.array([0, 10 ** 6]), "0..49"),
+    (np.ones(50, dtype=bool), "boolean"), (np.array([0.5, 1.0]), "integer")])
+def test_newton_rejects_bad_dirichlet_dofs(square, D, match):
+    _, b = square
+    model = Hyperelastic(b, mat.NeoHooke(1.0, 1.0))
+    with pytest.raises(ValueError, match=match):
+        pg.solvers.newton(model, D=D, verbose=False)
+
+
+def test_newton_rejects_wrong_length_vectors(square):
+    _, b = square
+    model = Hyperelastic(b, mat.NeoHooke(1.0, 1.0))
+    with pytest.raises(ValueError, match="f_ext"):
+        pg.solvers.newton(model, f_ext=np.zeros(b.N + 1), verbose=False)
+
+
+def test_form_dimension_must_match_the_basis(square):
+    mesh, _ = square
+    scalar = pg.FamilyBasis(mesh)  # dim=None
+    with pytest.raises(ValueError, match="dim="):
+        pg.assemble(linear_elasticity(1.0, 1.0), scalar)
+
+    @fem.BilinearForm
+    def laplace(u, v, w):
+        return u.grad[0] * v.grad[0] + u.grad[1] * v.grad[1]
+    with pytest.raises(ValueError, match="scalar"):
+        pg.assemble(laplace, pg.FamilyBasis(mesh, dim=2))
+    assert pg.assemble(laplace, scalar).shape == (25, 25)
