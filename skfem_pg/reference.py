@@ -1,13 +1,19 @@
 """FE overkill references: a scene solved on a refined mesh with a
 quadratic element, cached on disk, and evaluated anywhere.
 
-The cache key is a hash of the scene (:meth:`Scene.key`), the coarse mesh
-and the refinement/element, so a changed load or material never reuses a
-stale reference.  Files live in ``$SKFEM_PG_CACHE`` (default
-``~/.cache/skfem_pg``).
+The cache key is :meth:`Scene.fingerprint`: a hash of everything that
+defines the problem — mesh vertices, elements and named boundaries, probes,
+material type and parameters and loads at full precision — and of the
+refinement and element, so a changed problem never reuses a stale
+reference.  Files live in ``$SKFEM_PG_CACHE`` (default
+``~/.cache/skfem_pg``); they are written atomically (temporary file, then
+rename), an unreadable entry is recomputed with a warning naming it, and a
+cache that cannot be written warns and still returns the reference.
 """
-import hashlib
 import os
+import tempfile
+import warnings
+import zipfile
 
 import numpy as np
 import skfem as fem
@@ -17,12 +23,45 @@ from .scenes import FE_METHODS
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
 
+#: bump when the stored content changes meaning
+CACHE_FORMAT = 2
+
+
 def cache_dir():
-    d = os.environ.get("SKFEM_PG_CACHE",
-                       os.path.join(os.path.expanduser("~"), ".cache",
-                                    "skfem_pg"))
-    os.makedirs(d, exist_ok=True)
-    return d
+    """``$SKFEM_PG_CACHE`` or ``~/.cache/skfem_pg`` (not created here)."""
+    return os.environ.get("SKFEM_PG_CACHE",
+                          os.path.join(os.path.expanduser("~"), ".cache",
+                                       "skfem_pg"))
+
+
+def _load(fn, mesh_type):
+    with np.load(fn) as data:
+        mesh = mesh_type(data["p"], data["t"])
+        probes = {k[6:]: data[k] for k in data.files
+                  if k.startswith("probe_")}
+        return mesh, data["u"], probes
+
+
+def _store(fn, **arrays):
+    """Write ``fn`` atomically; warn (and return False) if it cannot be
+    written."""
+    d = os.path.dirname(fn)
+    try:
+        os.makedirs(d, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp.npz")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, **arrays)
+            os.replace(tmp, fn)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+    except OSError as err:
+        warnings.warn("could not write the overkill reference cache {} "
+                      "({}); the reference is used but not kept".format(
+                          fn, err))
+        return False
+    return True
 
 
 class Reference:
@@ -84,23 +123,23 @@ def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
     base = {fem.MeshTri1: "T1", fem.MeshQuad1: "Q1", fem.MeshTet1: "O1",
             fem.MeshHex1: "H1"}[type(scene.mesh)]
     method = method or QUADRATIC[base]
-    h = hashlib.sha1()
-    h.update(scene.key().encode())
-    h.update(np.ascontiguousarray(scene.mesh.p).tobytes())
-    h.update(np.ascontiguousarray(scene.mesh.t).tobytes())
-    h.update("{}|{}".format(refine, method).encode())
-    fn = os.path.join(cache_dir(), "{}-{}.npz".format(scene.name,
-                                                      h.hexdigest()[:16]))
+    key = scene.fingerprint(refine, method, CACHE_FORMAT)
+    fn = os.path.join(cache_dir(), "{}-{}.npz".format(scene.name, key[:20]))
     mesh = scene.mesh.refined(refine) if refine else scene.mesh
     if os.path.exists(fn):
-        data = np.load(fn)
-        mesh = type(scene.mesh)(data["p"], data["t"])
-        probes = {k[6:]: data[k] for k in data.files if k.startswith("probe_")}
-        return Reference(mesh, method, data["u"], probes)
+        try:
+            mesh, u, probes = _load(fn, type(scene.mesh))
+            return Reference(mesh, method, u, probes)
+        except (OSError, ValueError, KeyError, EOFError,
+                zipfile.BadZipFile) as err:
+            warnings.warn("the cached overkill reference {} is unreadable "
+                          "({}: {}); recomputing it".format(
+                              fn, type(err).__name__, err))
+            mesh = scene.mesh.refined(refine) if refine else scene.mesh
     if verbose:
         print("  computing the {} overkill reference on {} elements ..."
               .format(method, mesh.nelements), flush=True)
     res = scene.solve(method, mesh=mesh, **solve_kwargs)
-    np.savez(fn, p=mesh.p, t=mesh.t, u=res.u,
-             **{"probe_" + k: v for k, v in res.probes.items()})
+    _store(fn, p=mesh.p, t=mesh.t, u=res.u,
+           **{"probe_" + k: v for k, v in res.probes.items()})
     return Reference(mesh, method, res.u, res.probes)

@@ -23,6 +23,7 @@ O2, H2
 Every solve reports wall time split into preprocess (basis, families,
 corrections), assemble and linear solve (summed over Newton iterations).
 """
+import hashlib
 import time
 from dataclasses import dataclass, field
 
@@ -114,14 +115,49 @@ class Scene:
         return self.mesh.dim()
 
     def key(self):
-        """Text that identifies the problem (mesh geometry excluded): name,
-        material, boundary conditions, loads, parameters."""
-        return repr((self.name, repr(self.material), self.clamped,
-                     sorted((k, sorted(v.items()))
-                            for k, v in self.prescribed.items()),
-                     sorted((k, list(map(float, v)))
-                            for k, v in self.tractions.items()),
-                     sorted(self.params.items())))
+        """Text that identifies the problem apart from the mesh: name,
+        material (type and every parameter at full precision),
+        boundary conditions, loads, probes and parameters."""
+        def exact(v):
+            if isinstance(v, (float, np.floating)):
+                return float(v).hex()
+            if isinstance(v, np.ndarray):
+                return [exact(a) for a in v.ravel().tolist()]
+            if isinstance(v, dict):
+                return sorted((str(k), exact(a)) for k, a in v.items())
+            if isinstance(v, (list, tuple)):
+                return [exact(a) for a in v]
+            return repr(v)
+        material = (type(self.material).__module__,
+                    type(self.material).__qualname__,
+                    exact(vars(self.material)))
+        return repr((self.name, material, exact(list(self.clamped)),
+                     exact(self.prescribed),
+                     exact({k: np.asarray(v, float)
+                            for k, v in self.tractions.items()}),
+                     exact(self.probes), exact(self.params)))
+
+    def fingerprint(self, *extra):
+        """SHA-1 of :meth:`key`, the mesh (vertices, elements and every
+        named boundary's facets) and ``extra``: a reference solved for this
+        fingerprint is valid for exactly this problem."""
+        h = hashlib.sha1()
+        h.update(self.key().encode())
+        mesh = self.mesh
+        h.update(type(mesh).__name__.encode())
+        for a in (mesh.p, mesh.t):
+            h.update(str(a.shape).encode())
+            h.update(np.ascontiguousarray(a).tobytes())
+        for name in sorted(mesh.boundaries or {}):
+            h.update(name.encode())
+            h.update(np.sort(np.asarray(mesh.boundaries[name],
+                                        dtype=np.int64)).tobytes())
+        for name in sorted(getattr(mesh, "subdomains", None) or {}):
+            h.update(b"subdomain " + name.encode())
+            h.update(np.sort(np.asarray(mesh.subdomains[name],
+                                        dtype=np.int64)).tobytes())
+        h.update(repr(extra).encode())
+        return h.hexdigest()
 
     # -- bases ---------------------------------------------------------
     def fe_mesh(self, method, mesh=None):

@@ -1,0 +1,68 @@
+"""The FE-overkill cache is never stale and never corrupt."""
+import os
+
+import numpy as np
+import pytest
+import skfem as fem
+
+from skfem_pg import materials as mat
+from skfem_pg.reference import cache_dir, overkill
+from skfem_pg.scenes import Scene
+
+
+def _mesh(loaded="right"):
+    m = fem.MeshQuad.init_tensor(np.linspace(0, 4, 5), np.linspace(0, 1, 3))
+    return m.with_boundaries({
+        "left": lambda x: x[0] == 0,
+        "right": (lambda x: x[0] == 4) if loaded == "right"
+        else (lambda x: x[1] == 1)})
+
+
+def _scene(mesh=None, mu=1.0, probe=(4.0, 1.0)):
+    return Scene("cache-test", _mesh() if mesh is None else mesh,
+                 mat.NeoHooke(2.0, mu), clamped=["left"],
+                 tractions={"right": [0.0, 0.01]}, probes={"tip": probe})
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("SKFEM_PG_CACHE", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def _tip(scene):
+    return overkill(scene, refine=1, verbose=False).probes["tip"][1]
+
+
+def test_changed_problems_never_reuse_a_reference(cache):
+    base = _tip(_scene())
+    assert _tip(_scene()) == base and len(os.listdir(cache)) == 1
+    # the loaded boundary redefined under the same name (was: 77 % off)
+    moved = _tip(_scene(_mesh(loaded="top")))
+    assert abs(moved - base) > 0.1 * abs(base)
+    # a probe moved to another point
+    s = _scene(probe=(2.0, 1.0))
+    assert abs(_tip(s) - base) > 0.1 * abs(base)
+    # a material parameter changed in the 9th digit
+    s = _scene(mu=1.0 + 1e-9)
+    assert _tip(s) != base
+    assert len(os.listdir(cache)) == 4
+
+
+def test_a_corrupt_entry_is_recomputed(cache):
+    base = _tip(_scene())
+    (fn,) = list(cache.iterdir())
+    fn.write_bytes(fn.read_bytes()[:100])  # truncated
+    with pytest.warns(UserWarning, match=str(fn.name)):
+        again = _tip(_scene())
+    assert again == base
+    assert _tip(_scene()) == base  # rewritten whole
+
+
+def test_an_unwritable_cache_warns_and_returns(tmp_path, monkeypatch):
+    blocker = tmp_path / "not-a-directory"
+    blocker.write_text("x")  # a file where the cache directory should be
+    monkeypatch.setenv("SKFEM_PG_CACHE", str(blocker / "cache"))
+    with pytest.warns(UserWarning, match="could not write"):
+        tip = _tip(_scene())
+    assert np.isfinite(tip) and cache_dir() == str(blocker / "cache")
