@@ -67,7 +67,79 @@ def _check_elements(mesh, elements):
             "mesh element {} (centre {}) is degenerate or inverted "
             "(det J = {:.3g} .. {:.3g}); its particles would get a "
             "non-positive volume".format(
-                e, tuple(np.round(c, 6)), det[bad][0].min(), det[bad][0].max()))
+                e, tuple(float(v) for v in np.round(c, 6)),
+                det[bad][0].min(), det[bad][0].max()))
+    folded = folded_facets(mesh, elements)
+    if len(folded):
+        f = folded[0]
+        e = mesh.f2t[:, f]
+        c = mesh.p[:, mesh.facets[:, f]].mean(axis=1)
+        raise ParticleError(
+            "mesh elements {} and {} lie on the same side of their shared "
+            "facet {} (centre {}): the mesh is folded (a vertex pushed "
+            "through a neighbour; {} such facets), so its lumped volumes "
+            "overlap".format(e[0], e[1], f,
+                             tuple(float(v) for v in np.round(c, 6)),
+                             len(folded)))
+
+
+def folded_facets(mesh, elements=None, p=None):
+    """Interior facets (between two of ``elements``) whose two elements'
+    centroids lie on the same side of the facet's line/plane: a folded or
+    tangled mesh (vertex positions ``p``, default ``mesh.p``), which the
+    element Jacobians of simplices cannot show.  Returns facet indices."""
+    p = mesh.p if p is None else p
+    f2t = mesh.f2t
+    inner = np.nonzero(f2t[1] >= 0)[0]
+    if elements is not None:
+        keep = np.zeros(mesh.nelements, dtype=bool)
+        keep[elements] = True
+        inner = inner[keep[f2t[0, inner]] & keep[f2t[1, inner]]]
+    F = p[:, mesh.facets[:, inner]]  # (d, nvf, nf)
+    d = p.shape[0]
+    if d == 2:
+        e = F[:, 1] - F[:, 0]
+        n = np.array([-e[1], e[0]])
+    else:
+        n = np.cross(F[:, 1] - F[:, 0], F[:, 2] - F[:, 0], axis=0)
+    x0 = F.mean(axis=1)
+    c = p[:, mesh.t].mean(axis=1)  # element centroids
+    s0 = (n * (c[:, f2t[0, inner]] - x0)).sum(0)
+    s1 = (n * (c[:, f2t[1, inner]] - x0)).sum(0)
+    return inner[s0 * s1 >= 0]
+
+
+def inverted_cells(particles, u):
+    r"""Cells of the collocation mesh that the particle displacement ``u``
+    (scikit-fem nodal numbering) turns inside out.
+
+    PG checks :math:`J^{kj} > 0` at its own integration points only;
+    particles can still cross each other.  Mapping ``u`` onto the mesh the
+    particles were collocated from shows it: a cell is inverted where its
+    Jacobian changes sign (at the corners of multilinear cells) or, for
+    simplices, where it lies on the wrong side of a neighbour
+    (:func:`folded_facets`).  Returns the indices of inverted cells.
+    """
+    if particles.kind != "vertices" or particles.mesh is None:
+        raise ValueError("inverted_cells needs particles collocated from a "
+                         "mesh's vertices (Particles.from_mesh)")
+    mesh = particles.mesh
+    d = mesh.dim()
+    x = mesh.p + np.asarray(u, dtype=float).reshape(-1, d).T
+    tind = (np.arange(mesh.nelements) if particles.elements is None
+            else np.asarray(particles.elements))
+    deformed = type(mesh)(x, mesh.t)
+    if isinstance(mesh, (fem.MeshTri1, fem.MeshTet1)):  # constant det J
+        X, _ = fem.quadrature.get_quadrature(mesh.refdom, 1)
+    else:  # a multilinear Jacobian is extreme at the cell's corners
+        X = type(mesh).init_refdom().p
+    s0 = np.sign(mesh._mapping().detDF(X, tind=tind))
+    s1 = deformed._mapping().detDF(X, tind=tind) * s0
+    bad = np.zeros(mesh.nelements, dtype=bool)
+    bad[tind[np.any(s1 <= 0, axis=1)]] = True
+    folded = folded_facets(mesh, tind, p=x)
+    bad[mesh.f2t[:, folded].ravel()] = True
+    return np.nonzero(bad)[0]
 
 
 class Particles:

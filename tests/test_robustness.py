@@ -120,3 +120,42 @@ def test_non_integer_neighbour_counts_raise(n):
                                     np.linspace(0, 1, 5))
     with pytest.raises(pg.FamilyError, match="integer"):
         pg.families.nearest(pg.Particles.from_mesh(mesh), n)
+
+
+def test_folded_triangle_mesh_is_rejected():
+    m = fem.MeshTri.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
+    p = m.p.copy()
+    i = np.argmin(np.linalg.norm(p - 0.5, axis=0))
+    p[:, i] += [0.3, 0.15]  # pushed through its neighbour at (0.75, 0.5)
+    folded = fem.MeshTri(p, m.t)
+    # every element is valid on its own; their areas overlap
+    assert fem.Basis(folded, fem.ElementTriP1()).dx.sum() > 1.01
+    with pytest.raises(pg.ParticleError, match="folded"):
+        pg.Particles.from_mesh(folded)
+    tet = fem.MeshTet.init_tensor(*(np.linspace(0, 1, 4),) * 3)
+    q = tet.p.copy()
+    j = np.argmin(np.linalg.norm(q - 1 / 3, axis=0))
+    q[:, j] += 0.45
+    with pytest.raises(pg.ParticleError, match="folded|inverted"):
+        pg.Particles.from_mesh(fem.MeshTet(q, tet.t))
+
+
+@pytest.mark.parametrize("kind", ["quad", "tri"])
+def test_inverted_cells_of_a_particle_displacement(kind):
+    from skfem_pg.particles import inverted_cells
+    g = np.linspace(0, 1, 5)
+    mesh = (fem.MeshQuad if kind == "quad" else fem.MeshTri).init_tensor(g, g)
+    p = pg.Particles.from_mesh(mesh)
+    u = np.zeros(2 * mesh.nvertices)
+    assert len(inverted_cells(p, u)) == 0
+    u = 0.2 * mesh.p.T.ravel()  # a homogeneous stretch inverts nothing
+    assert len(inverted_cells(p, u)) == 0
+    u[:] = 0.0
+    i = np.argmin(np.linalg.norm(mesh.p - 0.5, axis=0))
+    u[2 * i] = 0.3  # past its right neighbour at x = 0.75
+    bad = inverted_cells(p, u)
+    around = np.any(mesh.t[:, bad] == i, axis=0)
+    if kind == "quad":  # the two cells whose corner Jacobian flips
+        assert len(bad) == 2 and np.all(around)
+    else:  # inverted triangles, and the ones they fold onto
+        assert 2 <= len(bad) <= 8 and np.sum(around) >= 2
