@@ -7,7 +7,7 @@ regular, the two node-set families of Fig. 7.11) quad node sets (FE: Q1)
 and the same nodes split into triangles (FE: T1).  For each PG variant:
 relative L2 / H1 errors at the finest node set, their ratio to FE's, the
 least-squares rates, and the setup + assembly + solve time relative to FE's.
-Writes benchmarks/out/accuracy_study.png (L2 error against nodes).
+Writes out/accuracy_study.png (L2 error against nodes).
 
     python benchmarks/accuracy_study.py [--sizes 8 16 32 64] [--distortion 0.3]
 """
@@ -18,10 +18,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.convergence import PlaneWaves, rates, solve_manufactured
 from skfem_pg.models import lame
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FIELD = PlaneWaves.hillman2019()
 LAM, MU = lame(100e3, 0.3)
 
@@ -128,8 +129,11 @@ def main(sizes=(8, 16, 32, 64), distortion=0.3):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64])
     ap.add_argument("--distortion", type=float, default=0.3,
                     help="node perturbation in units of h (0: regular)")
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.sizes, a.distortion)

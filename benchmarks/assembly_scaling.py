@@ -20,9 +20,10 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.models import lame, linear_elasticity
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FORM = linear_elasticity(*lame(1.0, 0.3))
 #: one direct solver for Q1 and PG alike (RCM + SuperLU, skfem_pg.solvers)
 SOLVER = pg.solvers.direct
@@ -135,15 +136,18 @@ def main(sizes, amg=False):
     os.makedirs(OUT, exist_ok=True)
     with open(os.path.join(OUT, "assembly_scaling.json"), "w") as fh:
         json.dump(rows, fh, indent=1)
-    print("wrote benchmarks/out/assembly_scaling.json")
+    print("wrote " + OUT + "/assembly_scaling.json")
     return rows
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--sizes", type=int, nargs="+",
                     default=[100, 200, 300, 400, 500])
     ap.add_argument("--amg", action="store_true",
                     help="also time CG + smoothed aggregation solves")
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.sizes, a.amg)

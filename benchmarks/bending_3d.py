@@ -23,7 +23,7 @@ the geometric nonlinearity:
 
 Node sets: gmsh tetrahedra (``meshes/cook3d.geo``, ``--sizes``) and
 regular hexahedral grids split into tetrahedra (``--grids``), distorted by
-±0.3h.  Writes ``benchmarks/out/bending_3d.png``.
+±0.3h.  Writes ``out/bending_3d.png``.
 
     python benchmarks/bending_3d.py [--sizes 5 3.5 2.5 2] [--grids 8 12 16]
 """
@@ -37,6 +37,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture
@@ -46,7 +47,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "demos"))
 from cook_3d import CORNER, T, cook3d  # noqa: E402
 
-OUT = os.path.join(HERE, "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 LAM, MU = 100.0, 40.0
 MATERIAL = mat.LinearElastic(LAM, MU)
 AREA = 0.5 * (44.0 + 16.0) * 48.0  # the Cook outline
@@ -193,16 +194,19 @@ def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
     rows = cook_table(sizes, ref.probes["corner"][2])
     os.makedirs(OUT, exist_ok=True)
     plot(rows, os.path.join(OUT, "bending_3d.png"))
-    print("wrote benchmarks/out/bending_3d.png")
+    print("wrote " + OUT + "/bending_3d.png")
     return rows
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--sizes", type=float, nargs="+",
                     default=[5, 3.5, 2.5, 2.0],
                     help="gmsh mesh sizes of the tetrahedral node sets")
     ap.add_argument("--grids", type=int, nargs="*", default=[8, 12, 16],
                     help="hex grids n x n x n/4 split into tetrahedra")
     args = ap.parse_args()
+    OUT = output_dir(args.out)
     main(args.sizes, args.grids)

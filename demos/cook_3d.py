@@ -20,7 +20,7 @@ n x n x n/4 hex grids
 with interior nodes distorted by ±0.3h (``--hex``; tetrahedra have no
 mean-dilatation element here).  Prints errors, wall time (preprocess /
 assemble / solve), the PG/O1 deviation and time ratios; writes
-demos/out/cook_3d.png and a VTU with von Mises stress.
+out/cook_3d.png and a VTU with von Mises stress.
 
     python demos/cook_3d.py [--sizes 5 3.5 2.5] [--hex 8 12 16]
 """
@@ -31,6 +31,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
@@ -38,7 +39,7 @@ from skfem_pg.reporting import (print_time_to_target, save_error_vs_time,
                                 wall_time)
 from skfem_pg.scenes import Scene
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 T, Q = 10.0, 4.0
 CORNER = (48.0, 60.0, T)
 MATERIAL = mat.NeoHookeIsoVol.from_lame(100.0, 40.0)
@@ -123,15 +124,18 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
                        "distorted hexahedra (H1P0)")
     pg.write_vtu(os.path.join(OUT, "cook_3d.vtu"), last.basis.particles,
                  **particle_fields(last.basis, MATERIAL, last.u))
-    print("wrote demos/out/cook_3d.png and cook_3d.vtu")
+    print("wrote " + OUT + "/cook_3d.png and cook_3d.vtu")
     return rows
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--sizes", type=float, nargs="+", default=[5, 3.5, 2.5],
                     help="gmsh mesh sizes of the tetrahedral node sets")
     ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16],
                     help="H1P0 hex grids n x n x n/4")
     args = ap.parse_args()
+    OUT = output_dir(args.out)
     main(args.sizes, args.hex)

@@ -5,7 +5,7 @@ Geometry (0,0), (48,44), (48,60), (0,44); E = 1, nu = 1/3, plane stress;
 left edge clamped, total shear load 1 on the right edge.  The quantity is the
 vertical displacement v(48, 52); the literature value is 23.96, our reference
 is a Q2 overkill solution (Richardson-extrapolated from 64x64 and 128x128,
-cached in demos/out/).
+cached in out/).
 
 Methods on the same nodes (regular and ±0.3h distorted node sets):
   T1, Q1          scikit-fem elements
@@ -14,7 +14,7 @@ Methods on the same nodes (regular and ±0.3h distorted node sets):
   VC PBG Unl      MTE1 + bond correction + V5 (the default FamilyBasis)
 
 Prints a table (error, preprocess / assemble / solve seconds) and writes
-demos/out/cook_membrane.png and a VTU of the finest VC PBG Unl solution.
+out/cook_membrane.png and a VTU of the finest VC PBG Unl solution.
 
     python demos/cook_membrane.py [--max-n 128]
 """
@@ -27,10 +27,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.reporting import plot_error_vs_time
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 POINT = np.array([48.0, 52.0])
 LITERATURE = 23.96
 
@@ -146,7 +147,7 @@ def main(max_n=64):
     b, u = last
     pg.write_vtu(os.path.join(OUT, "cook_membrane.vtu"), b.particles,
                  displacement=u)
-    print("\nwrote demos/out/cook_membrane.png and cook_membrane.vtu")
+    print("\nwrote " + OUT + "/cook_membrane.png and cook_membrane.vtu")
     return rows, ref
 
 
@@ -170,6 +171,10 @@ def plot(rows, ref, fn):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--max-n", type=int, default=64,
                     help="finest elements per side (even; default 64)")
-    main(ap.parse_args().max_n)
+    a = ap.parse_args()
+    OUT = output_dir(a.out)
+    main(a.max_n)

@@ -19,7 +19,7 @@ Methods on each node set (meshes/cook.geo, element sizes --sizes):
 
 Prints error, L2 error at the particles and wall time (preprocess /
 assemble / solve), the time each method needs for 1 % tip error, and the
-consistent-versus-FD tangent speedup; writes demos/out/cook_neohooke.png
+consistent-versus-FD tangent speedup; writes out/cook_neohooke.png
 and a VTU with displacement, F, Cauchy and von Mises stress.
 
     python demos/cook_neohooke.py [--sizes 4 2 1 0.5] [--ref-size 1]
@@ -29,6 +29,7 @@ import os
 
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
@@ -36,7 +37,7 @@ from skfem_pg.reporting import (print_time_to_target, save_error_vs_time,
                                 wall_time)
 from skfem_pg.scenes import Scene
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 MU, LAM = 40.0, 100.0
 TOTAL_SHEAR = 40.0
 TIP = (48.0, 60.0)
@@ -117,14 +118,17 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1):
     fields = particle_fields(last.basis, mat.NeoHooke(LAM, MU), last.u)
     pg.write_vtu(os.path.join(OUT, "cook_neohooke.vtu"),
                  last.basis.particles, **fields)
-    print("\nwrote demos/out/cook_neohooke.png and cook_neohooke.vtu")
+    print("\nwrote " + OUT + "/cook_neohooke.png and cook_neohooke.vtu")
     return rows
 
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--sizes", type=float, nargs="+", default=[4, 2, 1])
     ap.add_argument("--ref-size", type=float, default=1.0)
     ap.add_argument("--ref-refine", type=int, default=1)
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.sizes, a.ref_size, a.ref_refine)

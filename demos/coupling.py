@@ -10,7 +10,7 @@ FE–PG interface (FE-consistent), so the union passes the patch test.
 2. Cook's membrane (linear, plane stress, irregular nodes): Q1 left of
    x = 24, PG right of it, against pure Q1 and pure PG on the same nodes.
 
-Writes demos/out/coupling.png and coupling.vtu.
+Writes out/coupling.png and coupling.vtu.
 
     python demos/coupling.py
 """
@@ -20,12 +20,13 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
 from skfem_pg.models import lame, linear_elasticity
 
 from cook_membrane import FORM as COOK_FORM, reference, tip_dof
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 
 
 def coupled_bases(mesh, fe_side, dim=2, **kw):
@@ -102,7 +103,7 @@ def main():
     pg.write_vtu(os.path.join(OUT, "coupling.vtu"), pgb.particles,
                  displacement=res["Q1 | PG coupled"],
                  pg_particle=pgb.particles.active.astype(float))
-    print("\nwrote demos/out/coupling.png and coupling.vtu")
+    print("\nwrote " + OUT + "/coupling.png and coupling.vtu")
     return res
 
 
@@ -132,4 +133,9 @@ def plot(mesh, u, fe, pgb, fn):
 
 
 if __name__ == "__main__":
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
+    OUT = output_dir(ap.parse_args().out)
     main()

@@ -8,7 +8,7 @@ horizon, PPG Unl and FE Q1 on the same nodes.  Prints, per formulation,
 the number of zero eigenvalues (3 = rigid-body modes only), the number of
 soft modes below half of Q1's first deformation mode, and the first
 deformation eigenvalue; plots the lowest 40 eigenvalues and the first
-deformation mode of U1 and of VC PBG Unl (demos/out/eigenmodes.png).
+deformation mode of U1 and of VC PBG Unl (out/eigenmodes.png).
 
     python demos/eigenmodes.py [--nx 20 --ny 10] [--distortion 0.0]
 """
@@ -19,11 +19,12 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.reporting import save_figure
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.spectrum import classify, free_modes
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 
 
 def formulations(p):
@@ -92,8 +93,11 @@ def plot(mesh, spectra, fn):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--nx", type=int, default=20)
     ap.add_argument("--ny", type=int, default=10)
     ap.add_argument("--distortion", type=float, default=0.0)
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.nx, a.ny, a.distortion)

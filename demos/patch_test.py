@@ -6,7 +6,7 @@ the top edge.  PBG variants on regular quads, ±0.3h distorted quads and
 unstructured gmsh triangles (about 1345 particles, as in the thesis).
 
 Prints εL2, εH1 and the max nodal error next to the thesis values, and writes
-demos/out/patch_test.png (εL2 per variant and node set).
+out/patch_test.png (εL2 per variant and node set).
 
     python demos/patch_test.py
 """
@@ -16,9 +16,10 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.analysis import linear_patch_test
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 
 VARIANTS = {
     "PBG U1 (WTE1)": dict(shape="WTE1"),
@@ -74,7 +75,7 @@ def main():
             s, n, name, l2, h1, mx, ref))
     os.makedirs(OUT, exist_ok=True)
     plot(rows, os.path.join(OUT, "patch_test.png"))
-    print("\nwrote demos/out/patch_test.png")
+    print("\nwrote " + OUT + "/patch_test.png")
     return rows
 
 
@@ -101,4 +102,9 @@ def plot(rows, fn):
 
 
 if __name__ == "__main__":
+    import argparse
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
+    OUT = output_dir(ap.parse_args().out)
     main()

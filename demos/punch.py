@@ -14,7 +14,7 @@ remaining thickness under the punch (thesis: Q1 39 %, VC PBG Unl 1.3 %, of
 the initial thickness).  Beside it, the number of mesh cells that the final
 displacement turns inside out (``particles.inverted_cells``): PG checks
 J > 0 only at its own integration points (min J), so its particles can
-cross while every J^{kj} stays positive.  Writes demos/out/punch.png (final configurations)
+cross while every J^{kj} stays positive.  Writes out/punch.png (final configurations)
 and punch_pg.vtu.
 
     python demos/punch.py [--nx 64 --ny 32]
@@ -27,13 +27,14 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
 from skfem_pg.particles import inverted_cells
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.solvers import newton, ConvergenceError
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 E, NU = 1.0, 0.3
 
 
@@ -94,7 +95,7 @@ def main(nx=64, ny=32):
     b = runs["VC PBG Unl"]
     pg.write_vtu(os.path.join(OUT, "punch_pg.vtu"), b.particles,
                  **particle_fields(b, material, res["VC PBG Unl"]["u"]))
-    print("wrote demos/out/punch.png and punch_pg.vtu")
+    print("wrote " + OUT + "/punch.png and punch_pg.vtu")
     return res
 
 
@@ -122,7 +123,10 @@ def plot(mesh, res, runs, fn):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--nx", type=int, default=64)
     ap.add_argument("--ny", type=int, default=32)
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.nx, a.ny)

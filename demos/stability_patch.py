@@ -15,7 +15,7 @@ the particle disorder — the particle-scale roughness of the displacement,
 its difference to the MLS1 average of the family (zero for linear, O(h²)
 for smooth fields), relative to the initial stretch — at the end of each
 breathing period, and the energy drift.  Writes
-demos/out/stability_patch.png (snapshots, disorder vs time)
+out/stability_patch.png (snapshots, disorder vs time)
 and VTUs of the final states.
 
     python demos/stability_patch.py [--periods 10] [--size 0.11]
@@ -27,6 +27,7 @@ import numpy as np
 import scipy.sparse.linalg as spl
 
 import skfem_pg as pg
+from skfem_pg.reporting import output_dir
 from skfem_pg.reporting import save_figure
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
@@ -34,7 +35,7 @@ from skfem_pg.models import lame
 from skfem_pg.shape import mls1_master_values
 from skfem_pg.spectrum import classify, free_modes
 
-OUT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "out")
+OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FORMULATIONS = {"U1 (WTE1)": dict(shape="WTE1"), "VC PBG Unl": dict()}
 
 
@@ -182,7 +183,10 @@ def plot(p, runs, fn):
 
 if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--periods", type=int, default=10)
     ap.add_argument("--size", type=float, default=0.11)
     a = ap.parse_args()
+    OUT = output_dir(a.out)
     main(a.periods, a.size)

@@ -1,7 +1,8 @@
 """Node sets for tests and benchmarks: distorted meshes, Cook's membrane,
 gmsh geometries.
 
-gmsh is used through its Python API; ``.geo`` sources live in ``meshes/``.
+gmsh is used through its Python API; ``.geo`` sources ship as package data
+in ``skfem_pg/meshes/`` (:func:`geo_path`).
 """
 import os
 import tempfile
@@ -112,6 +113,12 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
 
 
 def geo_path(name):
-    """Path of a ``.geo`` file shipped in ``meshes/``."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    return os.path.join(os.path.dirname(here), "meshes", name)
+    """Path of a ``.geo`` file shipped with the package
+    (``skfem_pg/meshes/``: cook.geo, cook3d.geo, cube.geo, square.geo)."""
+    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "meshes")
+    fn = os.path.join(here, name)
+    if not os.path.isfile(fn):
+        raise FileNotFoundError("no mesh source {!r} in {} (available: {})"
+                                .format(name, here, ", ".join(sorted(
+                                    os.listdir(here)))))
+    return fn

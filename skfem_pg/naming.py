@@ -1,81 +1,145 @@
-r"""Thesis names of PG formulations (Table 7.1) <-> ``FamilyBasis`` options.
+r"""Thesis names of formulations (Table 7.1) <-> ``FamilyBasis`` options.
 
-A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn] {U1|Unl|U2}``,
-e.g. ``"VCBCPBG V5sn Unl"`` or ``"PPG Unl"``:
+A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
+{formulation} [TL|UL] [noBC]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
+``FEM {T1|Q1|O1|H1|Q1P0|H1P0|T2|Q2|O2|H2}`` for the FE comparators:
 
 ==========  ==============================================================
-``VC``      first-order variational consistency, variant ``V1``…``V5``
-            (default V5 with BC, else V3; VC2: the second-order correction)
-``BC``      bond correction
+``VC``      first-order variational consistency, correction functions
+            ``V1``…``V5`` (default V5 for PBG, V3 for PPG); ``VC2``: the
+            second-order correction (PBG: V4 functions, PPG1: V1)
+``BC``      bond correction (5.55) — **the default of every first-order
+            formulation** (U1, Unl) in Table 7.1, written or not; the
+            package's token ``noBC`` at the end switches it off
 ``PBG``     Bubnov–Galerkin; ``PPG`` = ``PPG1`` Petrov–Galerkin (4.21),
             ``PPG2`` (4.22)
+``p s sn``  boundary conditions of the VC system
+            (:mod:`skfem_pg.vc_boundary`); **default** ``sn``, as in
+            Table 7.1.  ``m`` (a package extension) is the package's
+            minimum-norm solve
 ``U1``      WTE1 (classical correspondence), ``Unl`` MTE1, ``U2`` WTE2
+``TL``      total Lagrangian reference frame (the default; ``UL``, updated
+            Lagrange, is not built yet)
 ==========  ==============================================================
 
-The thesis' boundary variants ``p``, ``s``, ``sn`` of the VC system (fixed
-correction at selected particles / at surface particles / normal component
-at surface particles) map to ``vc_boundary`` (:mod:`skfem_pg.vc_boundary`);
-without a suffix the package's minimum-norm solve is used
-(``vc_boundary="min-norm"``).  Mixed formulations (``UnlP0``, ``U2P1``,
-``Unl+P1C``, ...) are not implemented.
+So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
+``"BCPBG Unl TL"``.  The keyword API of :class:`~skfem_pg.FamilyBasis` has
+its own, measured defaults: the bond correction as there (on for MTE1) and
+the minimum-norm VC solve (``vc_boundary="min-norm"``), which passes the
+same patch tests and is less erratic than ``sn`` on 3-D tetrahedra
+(README); ``FamilyBasis.from_name(p, name, vc_boundary="min-norm")`` or
+the suffix ``m`` gets it for a thesis name.  The mixed and stabilized
+formulations (``UnlP0``, ``IUnlP0``, ``U2P1``, ``U2P1C``, ``Unl+P1C``,
+``U1SUnl``, ``U1SIG``) are recognised and raise ``NotImplementedError``.
 """
 import re
 
 SHAPES = {"U1": "WTE1", "Unl": "MTE1", "U2": "WTE2"}
+#: first-order formulations: the bond correction is their default
+FIRST_ORDER = ("U1", "Unl")
+#: Table 7.1's formulations that are not built yet
+PLANNED = ("UnlP0", "IUnlP0", "U2P1", "U2P1C", "Unl+P1C", "U1SUnl",
+           "U1SIG")
+FE_NAMES = ("T1", "Q1", "O1", "H1", "Q1P0", "H1P0", "T2", "Q2", "O2", "H2")
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
-                   r"(?:\s+(?P<variant>V[1-5])(?P<boundary>sn|s|p)?)?"
-                   r"\s+(?P<form>\S+)$")
+                   r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
+                   r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
+                   r"(?:\s+(?P<nobc>noBC))?$")
+_BOUNDARY = {"p": "p", "s": "s", "sn": "sn", "m": "min-norm"}
+
+
+def fe_method(name):
+    """``"Q1P0"`` for ``"FEM Q1P0"`` (or ``"Q1P0"``); ``None`` if ``name``
+    names no FE comparator."""
+    parts = name.split()
+    if len(parts) == 2 and parts[0] == "FEM" or len(parts) == 1:
+        if parts[-1] in FE_NAMES:
+            return parts[-1]
+        if parts[0] == "FEM":
+            raise ValueError("unknown FE comparator {!r}: FEM {}".format(
+                name, " / ".join(FE_NAMES)))
+    return None
 
 
 def parse(name):
     """``(kwargs, notes)`` for :class:`~skfem_pg.FamilyBasis` from a
-    thesis name; raises ``ValueError`` naming what is not understood."""
+    thesis name, with Table 7.1's defaults; raises ``ValueError`` naming
+    what is not understood and ``NotImplementedError`` for formulations
+    that are not built."""
+    if fe_method(name) is not None:
+        raise ValueError("{!r} is an FE comparator, not a family basis: "
+                         "use Scene.solve({!r})".format(name, name))
     m = _NAME.match(name.strip())
     if m is None:
         raise ValueError("cannot read the formulation name {!r}; expected "
-                         "e.g. 'VCBCPBG V5sn Unl' or 'PPG Unl'".format(name))
+                         "e.g. 'VCBCPBG V5sn Unl TL', 'PPG Unl' or 'FEM Q1'"
+                         .format(name))
     g = m.groupdict()
     form = g["form"]
-    if form not in SHAPES:
+    if form in PLANNED:
         raise NotImplementedError(
-            "formulation {!r} is not available: displacement formulations "
-            "U1, Unl, U2 only (mixed ones come later)".format(form))
+            "formulation {!r} ({}) is not built yet: this version has the "
+            "displacement formulations U1, Unl, U2".format(form, name))
+    if form not in SHAPES:
+        raise ValueError("unknown formulation {!r} in {!r}: U1, Unl, U2 "
+                         "(Table 7.1 also lists {})".format(
+                             form, name, ", ".join(PLANNED)))
+    if g["frame"] == "UL":
+        raise NotImplementedError("{!r}: the updated Lagrangian frame (UL) "
+                                  "is not built yet; TL is".format(name))
     method = {"PPG": "PPG1"}.get(g["method"], g["method"])
-    kw = {"shape": SHAPES[form], "method": method, "bond": bool(g["bc"])}
+    first_order = form in FIRST_ORDER
+    if g["bc"] and not first_order:
+        raise ValueError("{!r}: the bond correction is for first-order "
+                         "formulations (U1, Unl), not {}".format(name, form))
+    if g["bc"] and g["nobc"]:
+        raise ValueError("{!r} asks for BC and noBC".format(name))
+    kw = {"shape": SHAPES[form], "method": method,
+          "bond": first_order and not g["nobc"]}
     notes = []
     if g["vc"] is None:
-        if g["variant"]:
-            raise ValueError("{!r}: a correction variant without 'VC'"
-                             .format(name))
+        if g["variant"] or g["boundary"]:
+            raise ValueError("{!r}: a correction variant or boundary variant "
+                             "without 'VC'".format(name))
         kw["vc"] = None
-    elif g["vc"] == "VC2":
+        return kw, notes
+    if g["vc"] == "VC2":
         kw["vc"] = "VC2"
         own = "V4" if method == "PBG" else "V1"
         if g["variant"] not in (None, own):
             notes.append("VC2 {} uses the {} correction functions here, not "
                          "{}".format(method, own, g["variant"]))
     else:
-        kw["vc"] = g["variant"] or ("V5" if g["bc"] and method == "PBG"
+        kw["vc"] = g["variant"] or ("V5" if method == "PBG" and kw["bond"]
                                     else "V3")
-    if g["boundary"]:
-        if kw["vc"] is None:
-            raise ValueError("{!r}: a boundary variant without 'VC'"
-                             .format(name))
-        kw["vc_boundary"] = g["boundary"]
+    kw["vc_boundary"] = _BOUNDARY[g["boundary"] or "sn"]
+    if kw["vc"] == "VC2" and kw["vc_boundary"] == "sn":
+        raise NotImplementedError(
+            "{!r}: VC2 has the boundary variant 's' (e.g. 'VC2PPG V1s U2') "
+            "and the minimum-norm solve ('m'), not the default 'sn'"
+            .format(name))
+    if method == "PPG2" and kw["vc_boundary"] != "min-norm":
+        raise NotImplementedError(
+            "{!r}: the VC of PPG2 has only the minimum-norm solve: write "
+            "the suffix 'm' (e.g. 'VCPPG2 V3m Unl')".format(name))
     return kw, notes
 
 
 def name_of(basis):
-    """The thesis name of a :class:`~skfem_pg.FamilyBasis`."""
+    """The full thesis code of a :class:`~skfem_pg.FamilyBasis`, e.g.
+    ``"VCBCPBG V5m Unl TL"``: every option written, so that
+    :func:`parse` gives the basis back."""
     vc = basis.vc
+    form = {v: k for k, v in SHAPES.items()}[basis.shape]
+    first_order = form in FIRST_ORDER
     prefix = ("VC2" if vc == "VC2" else "VC" if vc else "") + \
         ("BC" if basis.bond else "")
     method = {"PPG1": "PPG"}.get(basis.method, basis.method)
-    form = {v: k for k, v in SHAPES.items()}[basis.shape]
     if vc == "VC2":
         variant = " V4" if basis.method == "PBG" else " V1"
     else:
         variant = " " + vc if vc else ""
-    if vc and basis.vc_boundary != "min-norm":
-        variant += basis.vc_boundary
-    return "{}{}{} {}".format(prefix, method, variant, form)
+    if vc:
+        variant += {v: k for k, v in _BOUNDARY.items()}[basis.vc_boundary]
+    tail = " noBC" if first_order and not basis.bond else ""
+    return "{}{}{} {} TL{}".format(prefix, method, variant, form, tail)

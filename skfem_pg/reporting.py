@@ -7,6 +7,19 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 import os
 
 
+def output_dir(path=None, create=True):
+    """Where demos and benchmarks write: ``path`` (their ``--out``), else
+    ``$SKFEM_PG_OUT``, else ``./out`` under the current directory — never
+    the installed package or the source tree.  Created if missing (unless
+    ``create=False``)."""
+    path = path or os.environ.get("SKFEM_PG_OUT") or os.path.join(
+        os.getcwd(), "out")
+    path = os.path.abspath(path)
+    if create:
+        os.makedirs(path, exist_ok=True)
+    return path
+
+
 def wall_time(row):
     """Preprocess + assemble + solve seconds of a row."""
     return row["preprocess"] + row["assemble"] + row["solve"]

@@ -198,10 +198,23 @@ class Scene:
     def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
               tangent="consistent", **basis_kwargs):
         """Solve with ``"PG"`` (``basis_kwargs`` go to ``FamilyBasis``,
-        e.g. ``method="PPG1"``) or an FE method of :data:`FE_METHODS`;
-        returns a :class:`Result`."""
-        method = scheme
+        e.g. ``method="PPG1"``), a thesis name (``"VCBCPBG V5sn Unl TL"``,
+        :mod:`skfem_pg.naming`; ``basis_kwargs`` override it) or an FE
+        method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``); returns a
+        :class:`Result`."""
+        from .naming import fe_method, parse
+        method = fe_method(scheme) or scheme
         t0 = time.perf_counter()
+        if method not in FE_METHODS and method != "PG":
+            try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
+                kw, _ = parse(method)
+            except ValueError as err:
+                raise ValueError("unknown method {!r}: 'PG', a thesis name "
+                                 "(e.g. 'VCPBG Unl') or one of {} ({})"
+                                 .format(method, ", ".join(FE_METHODS),
+                                         err)) from None
+            basis_kwargs = {**kw, **basis_kwargs}
+            method = "PG"
         if method == "PG":
             mesh = self.mesh if mesh is None else mesh
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
@@ -234,7 +247,7 @@ class Scene:
         times = {"preprocess": t_pre,
                  "assemble": sum(h["t_assemble"] for h in hist),
                  "solve": sum(h["t_linear"] for h in hist)}
-        return Result(method, u, basis, self.evaluate(basis, u), times, hist)
+        return Result(scheme, u, basis, self.evaluate(basis, u), times, hist)
 
     def evaluate(self, basis, u):
         """Displacements at the probe points."""

@@ -158,7 +158,7 @@ def test_vc2_ppg_v1s_u2_passes_the_quadratic_patch_test():
         r = quadratic_patch_test(m, top, shape="WTE2", method="PPG1",
                                  vc="VC2", vc_boundary="s")
     assert r["max_error"] <= 1e-10  # measured 1.7e-12
-    assert r["basis"].name == "VC2PPG V1s U2"
+    assert r["basis"].name == "VC2PPG V1s U2 TL"
     assert r["basis"].vc_report.solver == "direct"
     # unlike PBG's VC2 (V4), the full PPG1 system is compatible: LSQR
     # reaches the constraints without excluding particles (its tolerance
