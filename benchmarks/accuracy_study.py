@@ -112,6 +112,7 @@ def plot(all_series, fn, distortion=0.3):
 
 
 def main(sizes=(8, 16, 32, 64), distortion=0.3):
+    print(pg.threads.describe())
     print("Manufactured solution (thesis 7.7), full Dirichlet, ±{}h "
           "distorted; errors relative, rates = least squares over nodes "
           "per side {}".format(distortion, list(sizes)))

@@ -92,6 +92,7 @@ def run(n, generic=False, pg_solve=False, amg=False):
 
 
 def main(sizes, amg=False):
+    print(pg.threads.describe())
     rows = []
     hdr = ("{:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s}"
            " {:>8s} {:>8s} {:>9s} {:>9s}")

@@ -173,6 +173,7 @@ def plot(rows, path):
 
 
 def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
+    print(pg.threads.describe())
     warnings.filterwarnings("ignore", message="Indefinite matrix")
     geo = pg.meshing.geo_path("cook3d.geo")
     sets = [("gmsh size {}".format(s), pg.meshing.from_geo(geo, size=s))

@@ -85,6 +85,7 @@ def run(sc, name, kw, label, w_ref, rows):
 
 
 def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
+    print(pg.threads.describe())
     ref = overkill(scene(cook3d(16, 4)), refine=0, method="H2")
     w_ref = ref.probes["corner"][2]
     print("3-D Cook's membrane, q = {} in z, thickness {}; H2 overkill "

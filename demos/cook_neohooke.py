@@ -66,6 +66,7 @@ def gmsh_cook(size):
 
 
 def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1):
+    print(pg.threads.describe())
     print("Cook's membrane, neo-Hooke (mu={}, lambda={}), total shear {}"
           .format(MU, LAM, TOTAL_SHEAR))
     ref = overkill(scene(gmsh_cook(ref_size)), refine=ref_refine)

@@ -9,7 +9,8 @@ scikit-fem's own assembly, so the same ``BilinearForm`` assembles FE and PG.
 >>> basis.vc_report.residual_after < 1e-10
 True
 """
-from . import families, shape, corrections, meshing, materials, solvers, models
+from . import (families, shape, corrections, meshing, materials, solvers,
+               models, threads)
 from .errors import (ParticleError, FamilyError, CorrectionError,
                      UnsupportedMeshError, SlowAssemblyWarning)
 from .particles import Particles

@@ -39,6 +39,7 @@ from skfem.element import DiscreteField, ElementVector
 
 from .basis import FamilyBasis
 from .shape.common import chunks
+from .threads import kernel
 
 
 class _FamilyView:
@@ -285,6 +286,7 @@ def _assemble_bilinear(form, basis, view, vview, kwargs):
     return assemble_local(basis, local_matrices, view, transposed=True)
 
 
+@kernel
 def assemble_local(basis, local_matrices, view=None, transposed=False):
     """Sparse matrix from local element/family matrices.
 
@@ -341,6 +343,7 @@ def _assemble_linear(form, basis, view, kwargs):
     return b
 
 
+@kernel
 def assemble(form, basis, vbasis=None, **kwargs):
     """Assemble ``form`` on ``basis`` with batched local matrices.
 

@@ -46,6 +46,7 @@ from .corrections import (bond_correction, check_correction,
 from .errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
+from .threads import kernel
 from .shape.least_squares import (mls1_master_gradients,
                                    wls1_master_gradients,
                                    wls2_master_gradients)
@@ -181,6 +182,7 @@ class FamilyBasis(AbstractBasis):
 
     """
 
+    @kernel
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
@@ -463,6 +465,7 @@ class FamilyBasis(AbstractBasis):
         Gr[c] = grad
         return (DiscreteField(V, Gr),)
 
+    @kernel
     def interpolate(self, w):
         r"""Values and gradients of the nodal field ``w`` at the members:
         value :math:`u^j`, gradient :math:`\sum_i u^i\otimes G^{kji}`

@@ -31,6 +31,7 @@ import skfem as fem
 from skfem.helpers import ddot, grad
 
 from .assembly import assemble
+from .threads import kernel
 from .materials import NeoHookeIsoVol, inverse_and_det
 from .tangents import fd_tangent
 
@@ -91,18 +92,22 @@ class Hyperelastic:
         d = _dim(basis)
         self._eye = np.eye(d).reshape(d, d, 1, 1)
 
+    @kernel
     def state(self, u):
         return {"F": self.basis.interpolate(u).grad + self._eye}
 
     def min_J(self, state):
         return float(_det(state["F"]).min())
 
+    @kernel
     def stress(self, state):
         return self.material.stress(state["F"])
 
+    @kernel
     def internal_force(self, state):
         return assemble(internal_force, self.basis, P=self.stress(state))
 
+    @kernel
     def tangent(self, state):
         if self.tangent_kind == "fd":
             return fd_tangent(self.basis, self.material, state["F"])
@@ -124,6 +129,7 @@ class MeanDilatation(Hyperelastic):
         self.material_full = NeoHookeIsoVol(mu, K)
         self._V = basis.dx.sum(axis=1)
 
+    @kernel
     def state(self, u):
         s = super().state(u)
         J = _det(s["F"])
@@ -134,12 +140,14 @@ class MeanDilatation(Hyperelastic):
     def _pressure(self, Theta):
         return 0.5 * self.K * (Theta - 1.0 / Theta)
 
+    @kernel
     def stress(self, state):
         F, J = state["F"], state["J"]
         FinvT = np.swapaxes(inverse_and_det(F)[0], 0, 1)
         p = self._pressure(state["Theta"])[:, None]
         return self.material.stress(F) + p * J * FinvT
 
+    @kernel
     def tangent(self, state):
         F, J, Theta = state["F"], state["J"], state["Theta"]
         Finv = inverse_and_det(F)[0]

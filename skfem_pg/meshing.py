@@ -88,7 +88,10 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
     ``mesh.boundaries``/``mesh.subdomains``.
     """
     import gmsh
-    gmsh.initialize(interruptible=False)
+    try:  # no SIGINT handler of gmsh's own (gmsh >= 4.12)
+        gmsh.initialize(interruptible=False)
+    except TypeError:  # gmsh 4.11
+        gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.open(str(path))
