@@ -492,6 +492,79 @@ class FamilyBasis(AbstractBasis):
         grad = np.swapaxes(self.G, -1, -2) @ U[:, None]  # (nf, m, d, nc)
         return DiscreteField(value, grad.transpose(3, 2, 0, 1))
 
+    # -- scikit-fem idioms -------------------------------------------------
+    def _collocation_basis(self, what):
+        if self.mesh is None:
+            raise NotImplementedError(
+                "{} needs particles collocated from a mesh's vertices; for "
+                "{} particles use the particle values directly (u[basis."
+                "nodal_dofs]) or skfem_pg.postprocess.particle_fields"
+                .format(what, self.particles.kind))
+        return fem.Basis(self.mesh, self.elem)
+
+    def probes(self, x):
+        r"""Sparse matrix ``P`` with ``P @ u`` the field at points ``x``
+        (``(dim, n)``), as scikit-fem's ``CellBasis.probes``: the linear
+        (P1/Q1) interpolant of the particle values on the collocation mesh
+        — the particle values themselves at the particles.  PG has no
+        shape-function values between particles (:math:`N^{ki}(X^j) =
+        \delta_{ij}`); this is the interpolation its loads and VTU output
+        use."""
+        return self._collocation_basis("probes").probes(
+            np.asarray(x, dtype=float))
+
+    def project(self, interp, **kwargs):
+        r"""Particle values of ``interp``: a callable of positions ``x``
+        (``(dim, n)``, returning ``(n,)`` or ``(ncomp, n)``) or a dof
+        vector.  With the PBG weights the mass matrix is diagonal and
+        :math:`\sum_j w_{kj} N^{ki}(X^j) N^{kl}(X^j) = \delta_{il} V^i`, so
+        the L2 projection *is* the nodal interpolation.  Quadrature-point
+        fields (``DiscreteField``) are not accepted: average them with
+        :func:`skfem_pg.postprocess.particle_fields` instead."""
+        if kwargs:
+            raise TypeError("FamilyBasis.project takes no options ({})"
+                            .format(", ".join(kwargs)))
+        nc = 1 if self.ncomp is None else self.ncomp
+        if callable(interp):
+            v = np.asarray(interp(self.particles.x), dtype=float)
+            if v.shape not in ((nc, self.particles.n),) + (
+                    ((self.particles.n,),) if nc == 1 else ()):
+                raise ValueError("the projected function must return shape "
+                                 "{}, got {}".format(
+                                     (nc, self.particles.n), v.shape))
+            return v.reshape(nc, -1).T.ravel()
+        v = np.asarray(interp)
+        if isinstance(interp, DiscreteField) or v.shape != (self.N,):
+            raise NotImplementedError(
+                "FamilyBasis.project takes a callable of x or a dof vector "
+                "of length {}; quadrature-point data: use "
+                "skfem_pg.postprocess.particle_fields".format(self.N))
+        return v.astype(float).copy()
+
+    def plot(self, z, **kwargs):
+        """scikit-fem's matplotlib ``plot`` of a scalar particle field on
+        the collocation mesh (P1/Q1 interpolant); vector fields: plot a
+        component, ``basis.plot(u[basis.nodal_dofs[0]])``."""
+        z = np.asarray(z)
+        if z.shape != (self.particles.n,):
+            raise ValueError("plot takes one value per particle ({}), got "
+                             "shape {}; for a vector field plot a component"
+                             ", e.g. u[basis.nodal_dofs[0]]".format(
+                                 self.particles.n, z.shape))
+        if self.mesh is None:
+            raise NotImplementedError(
+                "plot needs a collocation mesh; scatter the particles "
+                "(basis.particles.x) or write a VTU (skfem_pg.write_vtu)")
+        e1, _ = linear_elements(self.mesh)
+        from skfem.visuals.matplotlib import plot
+        return plot(fem.Basis(self.mesh, e1), z, **kwargs)
+
+    def draw(self, **kwargs):
+        """The collocation mesh (scikit-fem's ``mesh.draw``)."""
+        if self.mesh is None:
+            raise NotImplementedError("draw needs a collocation mesh")
+        return self.mesh.draw(**kwargs)
+
     def global_coordinates(self):
         mem, _ = self.families.padded()
         return DiscreteField(np.moveaxis(self.particles.x.T[mem], -1, 0))

@@ -4,12 +4,17 @@ import meshio
 
 
 def write_vtu(filename, particles, **point_data):
-    """Write particles as VTK vertices with nodal fields.
+    """Write particles and their fields for ParaView.
 
-    ``point_data`` values are arrays with one row per particle (``(n,)``,
-    ``(n, k)``) or scikit-fem dof vectors of length ``k·n`` (interleaved
-    components), which are reshaped to ``(n, k)``.  2-D vectors are padded
-    to 3 components as ParaView expects.
+    Particles collocated from a mesh's vertices are written with the
+    collocation mesh's cells (those of the PG subdomain for an element
+    subset), so ParaView shows a surface or volume; other particle sets
+    (centroids, point clouds) as VTK vertices.  ``point_data`` values are
+    arrays with one row per particle (``(n,)``, ``(n, k)``, ``(n, d, d)``)
+    or scikit-fem dof vectors of length ``k·n`` (interleaved components),
+    reshaped to ``(n, k)``.  2-D vectors are padded to 3 components and
+    ``(n, d, d)`` tensors written as ``(n, 9)`` (3×3, zero-padded), as
+    ParaView expects.
     """
     n = particles.n
     pts = np.zeros((n, 3))
@@ -19,8 +24,29 @@ def write_vtu(filename, particles, **point_data):
         val = np.asarray(val, dtype=float)
         if val.ndim == 1 and val.shape[0] != n and val.shape[0] % n == 0:
             val = val.reshape(n, -1)
+        if val.shape[0] != n:
+            raise ValueError("field {!r} has {} rows, the particle set {} "
+                             "particles".format(name, val.shape[0], n))
+        if val.ndim == 3:  # (n, d, d) tensors -> 3x3
+            t = np.zeros((n, 3, 3))
+            t[:, :val.shape[1], :val.shape[2]] = val
+            val = t.reshape(n, 9)
         if val.ndim == 2 and val.shape[1] == 2:
             val = np.column_stack([val, np.zeros(n)])
         data[name] = val
-    cells = [("vertex", np.arange(n).reshape(-1, 1))]
-    meshio.write(filename, meshio.Mesh(pts, cells, point_data=data))
+    meshio.write(filename, meshio.Mesh(pts, _cells(particles),
+                                       point_data=data))
+
+
+def _cells(particles):
+    """The collocation mesh's cells (meshio's vertex order, via
+    scikit-fem), or VTK vertices."""
+    mesh = particles.mesh
+    if particles.kind == "vertices" and mesh is not None:
+        from skfem.io.meshio import to_meshio
+        block = to_meshio(mesh, encode_cell_data=False).cells[0]
+        t = block.data
+        if particles.elements is not None:
+            t = t[np.asarray(particles.elements)]
+        return [(block.type, t)]
+    return [("vertex", np.arange(particles.n).reshape(-1, 1))]

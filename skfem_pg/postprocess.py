@@ -35,16 +35,18 @@ def cauchy_and_von_mises(material, F):
 def particle_fields(basis, material, u):
     """``{"displacement", "F", "cauchy", "von_mises"}`` per particle of a
     vector :class:`~skfem_pg.FamilyBasis` (inactive particles: zeros),
-    shapes ``(n, d)``, ``(n, d*d)``, ``(n, 9)``, ``(n,)``."""
+    shapes ``(n, d)``, ``(n, 9)``, ``(n, 9)``, ``(n,)``; the tensors are
+    3×3 (plane strain in 2-D: :math:`F_{zz} = 1`), as ParaView reads
+    them."""
     p = basis.particles
     n, d = p.n, p.dim
     F = basis.interpolate(u).grad[:, :, :, 0] + np.eye(d)[:, :, None]
     sigma, vm = cauchy_and_von_mises(material, F)
     masters = basis.families.masters
     out = {"displacement": u.reshape(n, d),
-           "F": np.zeros((n, d * d)), "cauchy": np.zeros((n, 9)),
+           "F": np.zeros((n, 9)), "cauchy": np.zeros((n, 9)),
            "von_mises": np.zeros(n)}
-    out["F"][masters] = np.moveaxis(F, -1, 0).reshape(-1, d * d)
+    out["F"][masters] = np.moveaxis(_embed3(F), -1, 0).reshape(-1, 9)
     out["cauchy"][masters] = np.moveaxis(sigma, -1, 0).reshape(-1, 9)
     out["von_mises"][masters] = vm
     return out

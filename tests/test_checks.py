@@ -86,3 +86,29 @@ def test_form_dimension_must_match_the_basis(square):
     with pytest.raises(ValueError, match="scalar"):
         pg.assemble(laplace, pg.FamilyBasis(mesh, dim=2))
     assert pg.assemble(laplace, scalar).shape == (25, 25)
+
+
+def test_scikit_fem_idioms_on_a_family_basis(square):
+    import matplotlib
+    matplotlib.use("Agg")
+    mesh, b = square
+    lin = lambda x: np.array([x[0] + 2 * x[1], 3 * x[0] - x[1]])  # noqa
+    u = b.project(lin)
+    assert np.allclose(u.reshape(-1, 2).T, lin(mesh.p))
+    x = np.array([[0.3, 0.71], [0.4, 0.13]])
+    # the collocation mesh's Q1 interpolant: exact for linear fields,
+    # like scikit-fem's own probes on the same mesh
+    fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+    assert np.allclose(b.probes(x) @ u, fe.probes(x) @ fe.project(lin))
+    assert np.allclose(b.probes(x) @ u, lin(x).ravel())
+    scalar = pg.FamilyBasis(mesh)
+    z = scalar.project(lambda x: x[0])
+    assert scalar.plot(z) is not None and scalar.draw() is not None
+    with pytest.raises(ValueError, match="component"):
+        b.plot(u)
+    with pytest.raises(NotImplementedError, match="particle_fields"):
+        b.project(b.interpolate(u))
+    cloud = pg.Particles(mesh.p, np.full(mesh.nvertices, 1 / 16))
+    pb = pg.FamilyBasis(cloud, dim=2, vc=None)
+    with pytest.raises(NotImplementedError, match="particle_fields"):
+        pb.probes(x)
