@@ -517,8 +517,10 @@ class FamilyBasis(AbstractBasis):
         r"""Particle values of ``interp``: a callable of positions ``x``
         (``(dim, n)``, returning ``(n,)`` or ``(ncomp, n)``) or a dof
         vector.  With the PBG weights the mass matrix is diagonal and
-        :math:`\sum_j w_{kj} N^{ki}(X^j) N^{kl}(X^j) = \delta_{il} V^i`, so
-        the L2 projection *is* the nodal interpolation.  Quadrature-point
+        :math:`\sum_k\sum_j w_{kj} N^{ki}(X^j) N^{kl}(X^j) = \delta_{il}
+        m_i` with :math:`m_i = \sum_{k \ni i} w_{ki}`, and the L2 projection
+        :math:`\sum_k w_{ki} f(X^i) / m_i = f(X^i)` *is* the nodal
+        interpolation.  Quadrature-point
         fields (``DiscreteField``) are not accepted: average them with
         :func:`skfem_pg.postprocess.particle_fields` instead."""
         if kwargs:
