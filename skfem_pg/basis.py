@@ -305,6 +305,8 @@ class FamilyBasis(AbstractBasis):
             # VC2 of PPG1 corrects test functions only: V1 functions
             # (the thesis' VC2PPG V1s U2); of PBG, V4 (keeps the trial's
             # quadratic consistency)
+            surface = (particles.surface_area_vectors()
+                       if particles.mesh is not None else None)
             phi = correction_functions("V1" if vc == "VC2" and ppg else vc,
                                        x, V, families, n=weight_exponent)
             if vc == "VC2" and ppg:
@@ -317,12 +319,12 @@ class FamilyBasis(AbstractBasis):
                 Gt, self.vc_report = vc2_correction(
                     Gt, dx_t, x, V, families, area_vectors,
                     particles.area_moments(), phi, exclude=vc_exclude,
-                    boundary=vc_boundary, method="PPG1")
+                    boundary=vc_boundary, method="PPG1", surface=surface)
             elif vc == "VC2":
                 G, self.vc_report = vc2_correction(
                     G, self.dx, x, V, families, area_vectors,
                     particles.area_moments(), phi, exclude=vc_exclude,
-                    boundary=vc_boundary)
+                    boundary=vc_boundary, surface=surface)
             elif method == "PPG2":  # (5.17), its own sparse system
                 warnings.warn(
                     "VC PPG2 passes the patch test but is unstable here: "
@@ -337,12 +339,12 @@ class FamilyBasis(AbstractBasis):
                 Gt, self.vc_report = vc_correction(
                     Gt, dx_t, x, V, families, area_vectors, phi,
                     variant=vc, solver=vc_solver, exclude=vc_exclude,
-                    boundary=vc_boundary)
+                    boundary=vc_boundary, surface=surface)
             else:
                 G, self.vc_report = vc_correction(
                     G, self.dx, x, V, families, area_vectors, phi,
                     variant=vc, solver=vc_solver, exclude=vc_exclude,
-                    boundary=vc_boundary)
+                    boundary=vc_boundary, surface=surface)
             self.timings["vc"] = time.perf_counter() - t0
         check_correction(Gt if ppg else G, x, families, self.vc_report,
                          vc_tolerance, what="VC {} ({}{})".format(

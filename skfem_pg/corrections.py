@@ -265,7 +265,7 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True):
 
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                   solver="auto", tol=1e-14, maxiter=None, exclude=None,
-                  boundary="min-norm"):
+                  boundary="min-norm", surface=None):
     r"""Correct ``G`` so the PBG integration constraint holds.
 
     Parameters
@@ -311,6 +311,15 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         With ``s``/``sn`` the surface particles' discrete area vectors
         differ from :math:`A^i` by ``VCReport.area_correction``, which
         consistent Neumann loads must include.
+    surface
+        ``(d, np)`` area vectors over the true surface only (default
+        ``area``): with ``s``/``sn`` the particles where it is non-zero
+        are the surface particles, and its direction their normal.  For a
+        PG subdomain coupled to FE the interface particles have a non-zero
+        ``area`` but keep their constraints
+        (:meth:`~skfem_pg.Particles.surface_area_vectors`); under ``sn``
+        the surface particles on the interface's edge are fixed fully, as
+        under ``s`` (:func:`~skfem_pg.vc_boundary.interface_edge`).
 
     Returns
     -------
@@ -376,7 +385,9 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         return _solve_lsqr(A[rows], b[rows], tol, maxiter or 20 * unknowns)
 
     if boundary in ("s", "sn"):
-        R, T = vc_boundary.reduction(fam.masters, area, boundary, n, active)
+        R, T = vc_boundary.reduction(
+            fam.masters, area if surface is None else surface, boundary, n,
+            active, full=vc_boundary.interface_edge(area, surface))
         try:
             alpha = vc_boundary.solve_reduced(
                 constraint_matrix(phi, B, fam, n), b, R, T)

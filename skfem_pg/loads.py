@@ -89,15 +89,24 @@ def stress_load(basis, facets, P):
 
 def _area_correction(basis, facets):
     """The part of ``basis.area_correction`` that belongs to ``facets``:
-    scaled by :math:`|A^i_{facets}| / (|A^i_{facets}| + |A^i - A^i_{facets}|)`;
+    scaled by :math:`|A^i_{f}| / (|A^i_{f}| + |A^i_s - A^i_{f}|)`,
+    :math:`A^i_s` the area vector over the particles' own surface
+    (:meth:`~skfem_pg.Particles.outer_facets`), :math:`A^i_f` over the
+    loaded facets on it;
     ``None`` if the basis has no correction."""
     dA = getattr(basis, "area_correction", None)
     if dA is None:
         return None
     p = basis.particles
-    Af = p.area_vectors(facets)
+    # the released constraint belongs to the particles' own surface: the
+    # loaded facets outside the PG region (on an FE part) and an FE–PG
+    # interface (whose constraints are kept) take no share
+    own = np.asarray(p.outer_facets())
+    loaded = np.intersect1d(np.asarray(p.mesh.normalize_facets(facets)), own)
+    Af = (p.area_vectors(loaded) if len(loaded)
+          else np.zeros_like(dA))
     on = np.linalg.norm(Af, axis=0)
-    off = np.linalg.norm(p.area_vectors() - Af, axis=0)
+    off = np.linalg.norm(p.surface_area_vectors() - Af, axis=0)
     total = on + off
     share = np.divide(on, total, out=np.zeros_like(on), where=total > 0)
     return dA * share

@@ -301,6 +301,25 @@ class Particles:
                     else self.elements)
         return self.mesh.facets_around(elements)
 
+    def outer_facets(self):
+        """Boundary facets of the particles' region that lie on the mesh's
+        own boundary — not on an interface with the rest of the mesh (FE
+        elements in an FE–PG coupled model)."""
+        f = np.asarray(self.boundary_facets())  # one element each: no
+        return f[self.mesh.f2t[1, f] < 0]        # orientation needed
+
+    def surface_area_vectors(self):
+        """Area vectors over :meth:`outer_facets` only, ``(dim, n)``: the
+        true surface particles of a PG subdomain (what the VC boundary
+        variants ``s``/``sn`` release); equal to :meth:`area_vectors` for a
+        whole mesh and for centroid particles."""
+        if self.kind != "vertices" or self.elements is None:
+            return self.area_vectors()
+        if getattr(self, "_surface_area_vectors", None) is None:
+            self._surface_area_vectors = self.area_vectors(
+                self.outer_facets())
+        return self._surface_area_vectors
+
     def area_vectors(self, facets=None):
         r"""FE-consistent nodal area vectors, shape ``(dim, n)``.
 

@@ -155,7 +155,7 @@ def _blocks_to_csr(M, fam, d):
 
 def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
                    tol=1e-15, maxiter=None, boundary="min-norm",
-                   method="PBG"):
+                   method="PBG", surface=None):
     """Second-order VC correction of PBG derivatives ``G`` (quadratic
     consistent, e.g. WTE2); ``area`` :math:`A^i` ``(d, n)``, ``area2``
     :math:`A_2^i` ``(d, d, n)`` about the origin 0, ``phi`` the correction
@@ -189,7 +189,8 @@ def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
         keep[np.asarray(exclude, dtype=np.int64)] = False
     alpha = np.zeros((len(fam), d + 1, d))
     if boundary == "s":
-        surf, _, _ = vc_boundary.surface_frames(area)
+        surf, _, _ = vc_boundary.surface_frames(
+            area if surface is None else surface)
         keep[surf] = False
         cols = np.nonzero(keep[fam.masters])[0]
         # select the kept equations and unknowns; one LU (vc_boundary)

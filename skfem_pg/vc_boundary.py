@@ -57,13 +57,31 @@ def surface_frames(area):
     return surf, n, vt[:, 1:, :]
 
 
-def reduction(masters, area, boundary, n_particles, active):
+def interface_edge(area, surface):
+    """Surface particles that also lie on an FE–PG interface: a non-zero
+    ``surface`` vector (true surface) and a different ``area`` vector (the
+    PG region's boundary, interface included).  ``None`` without an
+    interface."""
+    if surface is None:
+        return None
+    area, surface = np.asarray(area), np.asarray(surface)
+    scale = max(np.abs(area).max(), 1e-300)
+    on = np.linalg.norm(surface, axis=0) > 1e-12 * scale
+    return on & (np.linalg.norm(area - surface, axis=0) > 1e-12 * scale)
+
+
+def reduction(masters, area, boundary, n_particles, active, full=None):
     """Sparse ``(R, T)`` for ``boundary`` ``"s"`` or ``"sn"``: the imposed
     equations are ``R @ (A α - b) = 0`` (interior particles: all
     components; surface particles under ``sn``: the tangential ones), the
     unknowns ``α = T @ γ`` (interior families: all components; families of
     surface particles under ``sn``: the tangential ones).  ``masters``:
-    the master particle of each family."""
+    the master particle of each family; ``area`` the true surface's area
+    vectors.  ``full`` (boolean per particle) marks surface particles
+    treated as under ``s`` even with ``sn``: those on the edge of an FE–PG
+    interface, where ``sn`` leaves the reduced system singular (one zero
+    singular value on a coupled quad patch, measured) and ``s`` does
+    not."""
     if boundary not in ("s", "sn"):
         raise ValueError("reduction() is for the boundary variants 's' and "
                          "'sn', got {!r}".format(boundary))
@@ -72,6 +90,9 @@ def reduction(masters, area, boundary, n_particles, active):
     surf, _, t = surface_frames(area)
     is_surf = np.zeros(n_particles, dtype=bool)
     is_surf[surf] = True
+    sn_at = is_surf.copy()  # surface particles with a tangential part
+    if full is not None:
+        sn_at &= ~np.asarray(full, dtype=bool)
 
     def operator(owners):
         """``(d·len(owners)) × n_reduced``: identity blocks for interior
@@ -84,7 +105,7 @@ def reduction(masters, area, boundary, n_particles, active):
         if boundary == "sn":
             pos = np.full(n_particles, -1)
             pos[surf] = np.arange(len(surf))
-            on = np.nonzero(is_surf[owners] & active[owners])[0]
+            on = np.nonzero(sn_at[owners] & active[owners])[0]
             tt = t[pos[owners[on]]]  # (non, d-1, d): [block, tangent, comp]
             rows.append(np.broadcast_to((d * on)[:, None, None]
                                         + np.arange(d), tt.shape).ravel())
