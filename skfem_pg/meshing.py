@@ -79,6 +79,49 @@ def cook_membrane(n, kind="quad"):
     })
 
 
+def plate_with_hole(a=1.0, L=5.0, n=8, m=None, ratio=6.0):
+    r"""Quarter of a square plate :math:`[-L, L]^2` with a central hole of
+    radius ``a``: the part :math:`x, y \ge 0`, structured quadrilaterals
+    (two transfinite blocks split along the diagonal, ``n`` cells along
+    each half of the hole's arc, ``m`` (default ``2n``) radially, graded
+    geometrically so that the outer cells are ``ratio`` times the inner
+    ones).  Boundaries ``hole``, ``left`` (x = 0), ``bottom`` (y = 0),
+    ``right`` (x = L), ``top`` (y = L)."""
+    m = 2 * n if m is None else m
+    q = ratio ** (1.0 / max(m - 1, 1))
+    eta = np.cumsum(np.r_[0.0, q ** np.arange(m)])
+    eta /= eta[-1]
+    xi = np.linspace(0.0, 1.0, n + 1)
+    XI, ETA = np.meshgrid(xi, eta, indexing="ij")  # (n+1, m+1)
+    blocks = []
+    for lower in (True, False):
+        th = XI * np.pi / 4 if lower else np.pi / 2 - XI * np.pi / 4
+        inner = a * np.array([np.cos(th), np.sin(th)])
+        outer = (np.array([np.full_like(XI, L), XI * L]) if lower
+                 else np.array([XI * L, np.full_like(XI, L)]))
+        P = (1 - ETA) * inner + ETA * outer
+        idx = np.arange(P[0].size).reshape(P[0].shape)
+        t = np.array([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:],
+                      idx[:-1, 1:]]).reshape(4, -1)
+        if not lower:  # keep the orientation counter-clockwise
+            t = t[[0, 3, 2, 1]]
+        blocks.append((P.reshape(2, -1), t))
+    p = np.hstack([blocks[0][0], blocks[1][0]])
+    t = np.hstack([blocks[0][1], blocks[1][1] + blocks[0][0].shape[1]])
+    key = np.round(p.T * 1e9).astype(np.int64)
+    _, first, inv = np.unique(key, axis=0, return_index=True,
+                              return_inverse=True)
+    mesh = fem.MeshQuad(p[:, first], inv.ravel()[t])
+    tol = 1e-9 * L
+    return mesh.with_boundaries({
+        "hole": lambda x: np.hypot(x[0], x[1]) < a + tol,  # chords
+        "left": lambda x: np.abs(x[0]) < tol,
+        "bottom": lambda x: np.abs(x[1]) < tol,
+        "right": lambda x: np.abs(x[0] - L) < tol,
+        "top": lambda x: np.abs(x[1] - L) < tol,
+    })
+
+
 def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
     """Mesh a gmsh ``.geo`` file and load it as a scikit-fem mesh.
 

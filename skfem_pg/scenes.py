@@ -181,7 +181,9 @@ class Scene:
         for name, comps in self.prescribed.items():
             dofs = basis.get_dofs(name)
             for c, val in comps.items():
-                idx = dofs.nodal["u^{}".format(c + 1)]
+                # every dof of the component: nodal, and the facet/edge
+                # dofs of quadratic elements (a constant's interpolant)
+                idx = dofs.all("u^{}".format(c + 1))
                 D.append(idx)
                 u_D[idx] = val
         D = np.unique(np.concatenate(D)) if D else np.zeros(0, int)
@@ -263,8 +265,20 @@ class Scene:
                                      .format(label, tuple(x)))
                 out[label] = u.reshape(-1, d)[i].copy()
             else:
-                out[label] = (basis.probes(x[:, None]) @ u).reshape(d)
+                xi = inside(basis.mesh, x[:, None])
+                out[label] = (basis.probes(xi) @ u).reshape(d)
         return out
+
+
+def inside(mesh, x, centroids=None):
+    """Points ``x`` (``(d, n)``) moved by 1e-8 of their distance towards
+    the nearest element centroid, so that points on the boundary (a probe
+    on a hole, a boundary point of another discretisation of the same
+    straight-sided domain) fall inside ``mesh`` for its element finder."""
+    from scipy.spatial import cKDTree
+    c = mesh.p[:, mesh.t].mean(axis=1) if centroids is None else centroids
+    _, i = cKDTree(c.T).query(np.asarray(x, float).T)
+    return x + 1e-8 * (c[:, i] - x)
 
 
 def _transfer_boundaries(old, new):
