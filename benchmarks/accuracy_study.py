@@ -18,10 +18,12 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import markdown_table, output_dir, update_results
 from skfem_pg.convergence import PlaneWaves, rates, solve_manufactured
 from skfem_pg.models import lame
 
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                       "README.md")  # the measured tables, written here
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FIELD = PlaneWaves.hillman2019()
 LAM, MU = lame(100e3, 0.3)
@@ -78,6 +80,7 @@ def report(kind, series):
         kind, fe[-1]["nodes"], fe_name))
     print("{:26s} {:>9s} {:>7s} {:>9s} {:>7s} {:>6s} {:>6s} {:>7s}".format(
         "variant", "L2", "/FE", "H1", "/FE", "rL2", "rH1", "time/FE"))
+    table = []
     for name, rows in series.items():
         h = [r["h"] for r in rows]
         r2 = rates(h, [r["L2"] for r in rows])[0]
@@ -89,6 +92,14 @@ def report(kind, series):
                   last["L2"] / fe[-1]["L2"], last["H1"],
                   last["H1"] / fe[-1]["H1"], r2, r1,
                   last["seconds"] / fe[-1]["seconds"]))
+        table.append([fe_name if name == "FE" else name,
+                      "{:.2e}".format(last["L2"]),
+                      "{:.2f}".format(last["L2"] / fe[-1]["L2"]),
+                      "{:.2e}".format(last["H1"]),
+                      "{:.2f}".format(last["H1"] / fe[-1]["H1"]),
+                      "{:.2f}".format(r2), "{:.2f}".format(r1),
+                      "{:.2f}".format(last["seconds"] / fe[-1]["seconds"])])
+    return table
 
 
 def plot(all_series, fn, distortion=0.3):
@@ -117,9 +128,23 @@ def main(sizes=(8, 16, 32, 64), distortion=0.3):
           "distorted; errors relative, rates = least squares over nodes "
           "per side {}".format(distortion, list(sizes)))
     all_series = {}
+    text = ["`python benchmarks/accuracy_study.py --sizes {} --distortion "
+            "{}`: manufactured solution (thesis (7.7)), full Dirichlet, "
+            "errors relative; `/FE` = ratio to Q1 (quads) or T1 "
+            "(triangles) on the same nodes at the finest set; rates: "
+            "least squares over all sets.".format(
+                " ".join(map(str, sizes)), distortion)]
     for kind in ("quad", "tri"):
         all_series[kind] = run(kind, sizes, distortion)
-        report(kind, all_series[kind])
+        table = report(kind, all_series[kind])
+        text.append("\n{} node sets, {} nodes at the finest:\n".format(
+            kind, all_series[kind]["FE"][-1]["nodes"]))
+        text.append(markdown_table(["variant", "L2", "L2/FE", "H1", "H1/FE",
+                                    "L2 rate", "H1 rate", "time/FE"],
+                                   table))
+    print("updated", update_results(RESULTS, "accuracy_study{}".format(
+        "" if distortion == 0.3 else "_{}".format(distortion)),
+        "\n".join(text)))
     os.makedirs(OUT, exist_ok=True)
     fn = os.path.join(OUT, "accuracy_study{}.png".format(
         "" if distortion == 0.3 else "_{}".format(distortion)))

@@ -20,9 +20,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import markdown_table, output_dir, update_results
 from skfem_pg.models import lame, linear_elasticity
 
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                       "README.md")  # the measured tables, written here
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FORM = linear_elasticity(*lame(1.0, 0.3))
 #: one direct solver for Q1 and PG alike (RCM + SuperLU, skfem_pg.solvers)
@@ -134,6 +136,20 @@ def main(sizes, amg=False):
                   r["particles"], r["pg_assemble_generic"],
                   r["pg_assemble_generic"] / r["pg_assemble"],
                   r["generic_vs_fast"]))
+    table = [[r["particles"], "{:.2f}".format(r["pg_preprocess"]),
+              "{:.2f}".format(r["pg_vc"]), "{:.2f}".format(r["ratio_asm"]),
+              "{:.2f}".format(r["ratio_pre_q1solve"]),
+              "{:.1f}".format(r["pg_solve"] / r["q1_solve"])
+              if "pg_solve" in r else "-"] for r in rows]
+    print("updated", update_results(
+        RESULTS, "assembly_scaling",
+        "`python benchmarks/assembly_scaling.py --sizes {}`: VC PBG Unl "
+        "and Q1, linear elasticity, ±0.3h distorted quads; both direct "
+        "solves by `pg.solvers.direct`; Q1 assembled by scikit-fem's "
+        "generic path.\n\n".format(" ".join(str(n) for n in sizes))
+        + markdown_table(["particles", "PG preprocess [s]", "of which VC "
+                          "[s]", "PG asm / Q1 asm", "preprocess / Q1 "
+                          "solve", "PG solve / Q1 solve"], table)))
     os.makedirs(OUT, exist_ok=True)
     with open(os.path.join(OUT, "assembly_scaling.json"), "w") as fh:
         json.dump(rows, fh, indent=1)

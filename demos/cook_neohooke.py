@@ -9,7 +9,7 @@ clearly nonlinear.  Quantity: vertical displacement of the top-right corner
 (48, 60), compared with a T2 overkill solution (cached in
 ~/.cache/skfem_pg, or $SKFEM_PG_CACHE).
 
-Methods on each node set (meshes/cook.geo, element sizes --sizes):
+Methods on each node set (skfem_pg/meshes/cook.geo, element sizes --sizes):
   T1                       scikit-fem P1 triangles, consistent tangent
   PBG Unl                  MTE1 + bond correction, no VC
   VC PBG Unl               MTE1 + bond correction + V5 (default FamilyBasis)
@@ -29,7 +29,7 @@ import os
 
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import markdown_table, output_dir, update_results
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
@@ -65,7 +65,7 @@ def gmsh_cook(size):
     return pg.meshing.from_geo(pg.meshing.geo_path("cook.geo"), size=size)
 
 
-def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1):
+def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1, results=None):
     print(pg.threads.describe())
     print("Cook's membrane, neo-Hooke (mu={}, lambda={}), total shear {}"
           .format(MU, LAM, TOTAL_SHEAR))
@@ -112,6 +112,20 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1):
               "Newton iterations {} vs {}".format(
                   c["nodes"], c["assemble"], f["assemble"],
                   f["assemble"] / c["assemble"], c["newton"], f["newton"]))
+    if results:
+        table = [[r["nodes"], r["method"], "{:.5f}".format(r["v"]),
+                  "{:.2e}".format(r["err"]), "{:.2e}".format(r["l2"]),
+                  r["newton"], "{:.3f}".format(wall_time(r))] for r in rows]
+        print("updated", update_results(
+            results, "cook_neohooke",
+            "`python demos/cook_neohooke.py --sizes {}`: neo-Hooke Cook's "
+            "membrane on gmsh triangle node sets; T2 overkill v = {:.5f} "
+            "({} elements).\n\n".format(
+                " ".join("{:g}".format(x) for x in sizes), v_ref,
+                ref.mesh.nelements)
+            + markdown_table(["nodes", "method", "v tip", "tip error",
+                              "L2 error", "Newton it.", "wall time [s]"],
+                             table)))
     os.makedirs(OUT, exist_ok=True)
     save_error_vs_time(os.path.join(OUT, "cook_neohooke.png"), rows, STYLES,
                        "relative error of v(48, 60)",
@@ -127,9 +141,11 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
+    ap.add_argument("--results", help="markdown page whose section of this "
+                    "demo is rewritten (e.g. benchmarks/README.md)")
     ap.add_argument("--sizes", type=float, nargs="+", default=[4, 2, 1])
     ap.add_argument("--ref-size", type=float, default=1.0)
     ap.add_argument("--ref-refine", type=int, default=1)
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.sizes, a.ref_size, a.ref_refine)
+    main(a.sizes, a.ref_size, a.ref_refine, a.results)

@@ -10,7 +10,8 @@ FE–PG interface (FE-consistent), so the union passes the patch test.
 2. Cook's membrane (linear, plane stress, irregular nodes): Q1 left of
    x = 24, PG right of it, against pure Q1 and pure PG on the same nodes.
 
-Writes out/coupling.png and coupling.vtu.
+Prints the patch-test errors and the tip displacements with their errors
+and times; writes out/coupling.png and coupling.vtu.
 
     python demos/coupling.py
 """

@@ -14,8 +14,8 @@ remaining thickness under the punch (thesis: Q1 39 %, VC PBG Unl 1.3 %, of
 the initial thickness).  Beside it, the number of mesh cells that the final
 displacement turns inside out (``particles.inverted_cells``): PG checks
 J > 0 only at its own integration points (min J), so its particles can
-cross while every J^{kj} stays positive.  Writes out/punch.png (final configurations)
-and punch_pg.vtu.
+cross while every J^{kj} stays positive.  Prints one line per method;
+writes out/punch.png (final configurations) and punch_pg.vtu.
 
     python demos/punch.py [--nx 64 --ny 32]
 """
@@ -31,6 +31,7 @@ from skfem_pg.reporting import output_dir
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
 from skfem_pg.particles import inverted_cells
+from skfem_pg.reporting import markdown_table, update_results
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.solvers import newton, ConvergenceError
 
@@ -68,7 +69,7 @@ def compress(basis, material, min_step=1e-3):
                 min_J=min(h["min_J"] for h in hist) if hist else np.nan)
 
 
-def main(nx=64, ny=32):
+def main(nx=64, ny=32, results=None):
     lam, mu = pg.models.lame(E, NU)
     material = mat.NeoHooke(lam, mu)
     mesh = block(nx, ny)
@@ -90,6 +91,20 @@ def main(nx=64, ny=32):
                   r["seconds"], r["min_J"], r["inverted"], mesh.nelements,
                   r["reason"]))
     print("  thesis: Q1 39 %, VC PBG Unl 1.3 % of the initial thickness")
+    if results:
+        table = [[name, "{:.2%}".format(1 - r["load"]),
+                  "{} of {}".format(r["inverted"], mesh.nelements),
+                  "{:.3g}".format(r["min_J"]), r["steps"], r["newton"],
+                  "{:.1f}".format(r["seconds"])] for name, r in res.items()]
+        print("updated", update_results(
+            results, "punch_{}x{}".format(nx, ny),
+            "`python demos/punch.py --nx {} --ny {}`: remaining thickness "
+            "under the punch when Newton stops (thesis: Q1 39 %, VC PBG "
+            "Unl 1.3 %), and the collocation cells the final displacement "
+            "turns inside out.\n\n".format(nx, ny)
+            + markdown_table(["method", "remaining thickness",
+                              "inverted cells", "min J", "steps",
+                              "Newton it.", "time [s]"], table)))
     os.makedirs(OUT, exist_ok=True)
     plot(mesh, res, runs, os.path.join(OUT, "punch.png"))
     b = runs["VC PBG Unl"]
@@ -125,8 +140,10 @@ if __name__ == "__main__":
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
+    ap.add_argument("--results", help="markdown page whose section of this "
+                    "demo is rewritten (e.g. benchmarks/README.md)")
     ap.add_argument("--nx", type=int, default=64)
     ap.add_argument("--ny", type=int, default=32)
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.nx, a.ny)
+    main(a.nx, a.ny, a.results)

@@ -20,6 +20,44 @@ def output_dir(path=None, create=True):
     return path
 
 
+def update_results(path, section, text):
+    """Replace the section ``section`` of the markdown results page
+    ``path`` (between ``<!-- begin NAME -->`` and ``<!-- end NAME -->``)
+    with ``text``, or append it: the benchmarks write their own measured
+    tables, so the page cannot drift from what the code does.  Returns
+    the path written, or ``None`` (with a printed note) if it cannot be
+    written — e.g. an installed copy without the source tree."""
+    import datetime
+    from . import threads
+    begin, end = ("<!-- begin {} -->".format(section),
+                  "<!-- end {} -->".format(section))
+    stamp = "*{}; {}.*".format(datetime.date.today().isoformat(),
+                               threads.describe())
+    block = "{}\n{}\n\n{}\n{}".format(begin, text.strip(), stamp, end)
+    try:
+        old = open(path).read() if os.path.exists(path) else ""
+        if begin in old and end in old:
+            head, rest = old.split(begin, 1)
+            new = head + block + rest.split(end, 1)[1]
+        else:
+            new = old.rstrip() + "\n\n" + block + "\n"
+        with open(path, "w") as fh:
+            fh.write(new)
+    except OSError as err:
+        print("could not update {} ({})".format(path, err))
+        return None
+    return path
+
+
+def markdown_table(header, rows):
+    """A markdown table from a header and rows of already formatted
+    cells."""
+    lines = ["| " + " | ".join(header) + " |",
+             "|" + "|".join(" ---: " for _ in header) + "|"]
+    lines += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
 def wall_time(row):
     """Preprocess + assemble + solve seconds of a row."""
     return row["preprocess"] + row["assemble"] + row["solve"]
