@@ -11,14 +11,14 @@ Writes out/accuracy_study.png (L2 error against nodes).
 
     python benchmarks/accuracy_study.py [--sizes 8 16 32 64] [--distortion 0.3]
 """
-import argparse
 import os
 
 import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import markdown_table, output_dir, update_results
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                update_results)
 from skfem_pg.convergence import PlaneWaves, rates, solve_manufactured
 from skfem_pg.models import lame
 
@@ -154,9 +154,7 @@ def main(sizes=(8, 16, 32, 64), distortion=0.3):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64])
     ap.add_argument("--distortion", type=float, default=0.3,
                     help="node perturbation in units of h (0: regular)")

@@ -11,7 +11,6 @@ drift between machines; the ratios are the result.
 
 (``--sizes`` are elements per side: 101² ≈ 10k ... 501² ≈ 250k particles.)
 """
-import argparse
 import json
 import os
 import time
@@ -20,7 +19,8 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import markdown_table, output_dir, update_results
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                update_results)
 from skfem_pg.models import lame, linear_elasticity
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -158,9 +158,7 @@ def main(sizes, amg=False):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--sizes", type=int, nargs="+",
                     default=[100, 200, 300, 400, 500])
     ap.add_argument("--amg", action="store_true",

@@ -27,7 +27,6 @@ regular hexahedral grids split into tetrahedra (``--grids``), distorted by
 
     python benchmarks/bending_3d.py [--sizes 5 3.5 2.5 2] [--grids 8 12 16]
 """
-import argparse
 import os
 import sys
 import time
@@ -37,7 +36,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture
@@ -200,9 +199,7 @@ def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--sizes", type=float, nargs="+",
                     default=[5, 3.5, 2.5, 2.0],
                     help="gmsh mesh sizes of the tetrahedral node sets")

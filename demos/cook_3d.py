@@ -24,14 +24,13 @@ out/cook_3d.png and a VTU with von Mises stress.
 
     python demos/cook_3d.py [--sizes 5 3.5 2.5] [--hex 8 12 16]
 """
-import argparse
 import os
 
 import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
@@ -130,9 +129,7 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--sizes", type=float, nargs="+", default=[5, 3.5, 2.5],
                     help="gmsh mesh sizes of the tetrahedral node sets")
     ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16],

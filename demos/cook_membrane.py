@@ -18,7 +18,6 @@ out/cook_membrane.png and a VTU of the finest VC PBG Unl solution.
 
     python demos/cook_membrane.py [--max-n 128]
 """
-import argparse
 import json
 import os
 import time
@@ -27,7 +26,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.reporting import plot_error_vs_time
 
@@ -170,9 +169,7 @@ def plot(rows, ref, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--max-n", type=int, default=64,
                     help="finest elements per side (even; default 64)")
     a = ap.parse_args()

@@ -24,17 +24,16 @@ and a VTU with displacement, F, Cauchy and von Mises stress.
 
     python demos/cook_neohooke.py [--sizes 4 2 1 0.5] [--ref-size 1]
 """
-import argparse
 import os
 
 
 import skfem_pg as pg
-from skfem_pg.reporting import markdown_table, output_dir, update_results
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
-from skfem_pg.reporting import (print_time_to_target, save_error_vs_time,
-                                wall_time)
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                print_time_to_target, save_error_vs_time,
+                                update_results, wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -138,11 +137,7 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1, results=None):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
-    ap.add_argument("--results", help="markdown page whose section of this "
-                    "demo is rewritten (e.g. benchmarks/README.md)")
+    ap = demo_parser(__doc__, results=True)
     ap.add_argument("--sizes", type=float, nargs="+", default=[4, 2, 1])
     ap.add_argument("--ref-size", type=float, default=1.0)
     ap.add_argument("--ref-refine", type=int, default=1)

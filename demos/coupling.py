@@ -21,7 +21,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
 from skfem_pg.models import lame, linear_elasticity
 
@@ -134,9 +134,6 @@ def plot(mesh, u, fe, pgb, fn):
 
 
 if __name__ == "__main__":
-    import argparse
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     OUT = output_dir(ap.parse_args().out)
     main()

@@ -12,14 +12,13 @@ deformation mode of U1 and of VC PBG Unl (out/eigenmodes.png).
 
     python demos/eigenmodes.py [--nx 20 --ny 10] [--distortion 0.0]
 """
-import argparse
 import os
 
 import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.reporting import save_figure
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.spectrum import classify, free_modes
@@ -92,9 +91,7 @@ def plot(mesh, spectra, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--nx", type=int, default=20)
     ap.add_argument("--ny", type=int, default=10)
     ap.add_argument("--distortion", type=float, default=0.0)

@@ -16,7 +16,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.analysis import linear_patch_test
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -102,9 +102,6 @@ def plot(rows, fn):
 
 
 if __name__ == "__main__":
-    import argparse
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     OUT = output_dir(ap.parse_args().out)
     main()

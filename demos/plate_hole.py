@@ -3,9 +3,9 @@
 The thesis gives this benchmark's geometry, material and load only in a
 figure (Fig. 7.32); the choices here: a square plate [-L, L]² (L = 5) with
 a central hole of radius a = 1 under uniaxial tension σ∞ = 1 in x, linear
-elastic (E = 1000, ν = 0.3, plane strain: strains of 1e-3).  The quarter x, y ≥ 0 is modelled
-with symmetry conditions on both cut lines (u_x = 0 on x = 0, u_y = 0 on
-y = 0), the traction on x = L.  Structured, radially graded quadrilaterals
+elastic (E = 1000, ν = 0.3, plane strain: strains of 1e-3).  The quarter
+x, y ≥ 0 is modelled with symmetry conditions on both cut lines (u_x = 0 on
+x = 0, u_y = 0 on y = 0), the traction on x = L.  Structured, radially graded quadrilaterals
 (``skfem_pg.meshing.plate_with_hole``).  PPG particles collocated from the
 cells within r < 2.5 a (the high stresses around the hole), Q1 elements
 elsewhere, coupled only through the shared interface nodes.
@@ -22,7 +22,6 @@ out/plate_hole.png (σ_xx along both lines) and plate_hole_vc.vtu.
 
     python demos/plate_hole.py [--n 16] [--out DIR]
 """
-import argparse
 import os
 import time
 
@@ -33,7 +32,8 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.models import lame, linear_elasticity
 from skfem_pg.reference import overkill
-from skfem_pg.reporting import markdown_table, output_dir, update_results
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                update_results)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -209,11 +209,7 @@ def plot(rows, lines_ref, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
-    ap.add_argument("--results", help="markdown page whose section of this "
-                    "demo is rewritten (e.g. benchmarks/README.md)")
+    ap = demo_parser(__doc__, results=True)
     ap.add_argument("--n", type=int, default=16,
                     help="cells along each half of the hole's arc")
     a = ap.parse_args()

@@ -19,7 +19,6 @@ writes out/punch.png (final configurations) and punch_pg.vtu.
 
     python demos/punch.py [--nx 64 --ny 32]
 """
-import argparse
 import os
 import time
 
@@ -27,7 +26,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
 from skfem_pg.particles import inverted_cells
@@ -137,11 +136,7 @@ def plot(mesh, res, runs, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
-    ap.add_argument("--results", help="markdown page whose section of this "
-                    "demo is rewritten (e.g. benchmarks/README.md)")
+    ap = demo_parser(__doc__, results=True)
     ap.add_argument("--nx", type=int, default=64)
     ap.add_argument("--ny", type=int, default=32)
     a = ap.parse_args()

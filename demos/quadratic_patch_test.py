@@ -18,14 +18,13 @@ fixed), by one sparse LU.
 
     python demos/quadratic_patch_test.py [--n 12]
 """
-import argparse
 import os
 
 import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.reporting import save_figure
 from skfem_pg.analysis import quadratic_patch_test
 
@@ -97,9 +96,7 @@ def plot(results, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--n", type=int, default=12)
     a = ap.parse_args()
     OUT = output_dir(a.out)

@@ -20,14 +20,13 @@ and VTUs of the final states.
 
     python demos/stability_patch.py [--periods 10] [--size 0.11]
 """
-import argparse
 import os
 
 import numpy as np
 import scipy.sparse.linalg as spl
 
 import skfem_pg as pg
-from skfem_pg.reporting import output_dir
+from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg.reporting import save_figure
 from skfem_pg import materials as mat
 from skfem_pg.mechanics import Hyperelastic
@@ -182,9 +181,7 @@ def plot(p, runs, fn):
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", help="output directory (default: "
-                    "$SKFEM_PG_OUT or ./out)")
+    ap = demo_parser(__doc__)
     ap.add_argument("--periods", type=int, default=10)
     ap.add_argument("--size", type=float, default=0.11)
     a = ap.parse_args()

@@ -20,6 +20,22 @@ def output_dir(path=None, create=True):
     return path
 
 
+def demo_parser(doc, results=False):
+    """The ``argparse`` parser of a demo or benchmark: its description is
+    the first line of ``doc``; ``--out`` (:func:`output_dir`) and, with
+    ``results``, ``--results`` (a markdown page whose section of this
+    script :func:`update_results` rewrites)."""
+    import argparse
+    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap.add_argument("--out", help="output directory (default: "
+                    "$SKFEM_PG_OUT or ./out)")
+    if results:
+        ap.add_argument("--results", help="markdown page whose section of "
+                        "this script is rewritten (e.g. "
+                        "benchmarks/README.md)")
+    return ap
+
+
 def update_results(path, section, text):
     """Replace the section ``section`` of the markdown results page
     ``path`` (between ``<!-- begin NAME -->`` and ``<!-- end NAME -->``)
