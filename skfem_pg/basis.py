@@ -270,8 +270,6 @@ class FamilyBasis(AbstractBasis):
             t0 = time.perf_counter()
             G = bond_correction(G, x, families)
             self.timings["bond"] = time.perf_counter() - t0
-        if vc is None:
-            check_correction(G, x, families, None, what=shape)
 
         mem, mask = families.padded()
         Vm = V[mem] * mask
@@ -346,11 +344,13 @@ class FamilyBasis(AbstractBasis):
                     variant=vc, solver=vc_solver, exclude=vc_exclude,
                     boundary=vc_boundary, surface=surface)
             self.timings["vc"] = time.perf_counter() - t0
+        what = ("{} {}".format(method, shape) if vc is None
+                else "VC {} ({}{})".format(
+                    vc, method, "" if vc_boundary == "min-norm"
+                    else ", boundary " + vc_boundary))
         check_correction(Gt if ppg else G, x, families, self.vc_report,
-                         vc_tolerance, what="VC {} ({}{})".format(
-                             vc, method, "" if vc_boundary == "min-norm"
-                             else ", boundary " + vc_boundary))
-        if ppg:
+                         vc_tolerance, what=what)
+        if ppg:  # the trial derivatives too
             check_correction(G, x, families, None, what=shape + " trial")
         self.G = G
         self.test = None
