@@ -142,11 +142,14 @@ def _needs_enlargement(x, fam, min_size):
 
 def _complete(x, A, masters, min_size, max_rings=3):
     """Build families from ``A`` and enlarge the deficient ones ring by
-    ring; families the rings cannot fix (isolated clusters) get their
-    ``min_size + dim`` nearest neighbours among the masters."""
+    ring; families the rings cannot fix (isolated clusters, or neighbours
+    all on one line of a strongly anisotropic node set) get their nearest
+    neighbours among the masters, ``min_size + dim`` first and then twice
+    as many per round until their members span the space."""
     fam = Families.from_adjacency(A, masters)
     A = A.tocsr().astype(bool)
-    for ring in range(max_rings + 1):
+    k = min(min_size + x.shape[0], len(masters))
+    for ring in range(max_rings + 64):
         need = _needs_enlargement(x, fam, min_size)
         if not np.any(need):
             break
@@ -156,8 +159,12 @@ def _complete(x, A, masters, min_size, max_rings=3):
                                (rows, rows)), shape=A.shape)
             A = (A + R @ A @ A).astype(bool)
         else:
-            k = min(min_size + x.shape[0], len(masters))
+            if ring > max_rings:
+                if k == len(masters):
+                    break  # cannot grow further: the shape kernels raise
+                k = min(2 * k, len(masters))
             _, nb = cKDTree(x[:, masters].T).query(x[:, rows].T, k=k)
+            nb = nb.reshape(len(rows), k)
             A = (A + sp.csr_matrix(
                 (np.ones(nb.size, dtype=bool),
                  (np.repeat(rows, k), masters[nb.ravel()])),

@@ -159,3 +159,19 @@ def test_inverted_cells_of_a_particle_displacement(kind):
         assert len(bad) == 2 and np.all(around)
     else:  # inverted triangles, and the ones they fold onto
         assert 2 <= len(bad) <= 8 and np.sum(around) >= 2
+
+
+def test_horizon_on_strongly_anisotropic_cells_raises():
+    """Cells 30:1 and a horizon of 2.01 mean spacings: the families are
+    single columns plus a neighbour or two (enlarged until they span the
+    plane) and the VC system is near-singular — |G|·h = 2e19, measured;
+    refused instead of returned."""
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 30, 11),
+                                    np.linspace(0, 1, 11))
+    p = pg.Particles.from_mesh(mesh)
+    fam = pg.families.horizon(p, factor=2.01)
+    with pytest.raises(pg.CorrectionError, match="blew"):
+        pg.FamilyBasis(p, fam, dim=2)
+    # the mesh's own connectivity is fine on the same particles
+    r = linear_patch_test(mesh, mesh.facets_satisfying(lambda x: x[1] == 1))
+    assert r["max_error"] <= 1e-10
