@@ -605,7 +605,9 @@ class FamilyBasis(AbstractBasis):
         if callable(nodes):
             nodes = np.nonzero(nodes(self.particles.x))[0]
         nc = 1 if self.ncomp is None else self.ncomp
-        nodes = np.asarray(nodes, dtype=np.int64)
+        from .solvers import as_dofs
+        nodes = as_dofs(nodes, self.particles.n,
+                        "particle indices (get_dofs nodes=)")
         return (nc * nodes[:, None] + np.arange(nc)).ravel()
 
     def complement_dofs(self, *D):

@@ -112,3 +112,14 @@ def test_scikit_fem_idioms_on_a_family_basis(square):
     pb = pg.FamilyBasis(cloud, dim=2, vc=None)
     with pytest.raises(NotImplementedError, match="particle_fields"):
         pb.probes(x)
+
+
+def test_get_dofs_of_point_particles_checks_indices():
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 3),
+                                    np.linspace(0, 1, 3))
+    cloud = pg.Particles(mesh.p, np.full(mesh.nvertices, 1 / 9))
+    b = pg.FamilyBasis(cloud, dim=2, vc=None)
+    assert list(b.get_dofs(nodes=[0, 8])) == [0, 1, 16, 17]
+    for bad in ([-1], [9], [0.5]):
+        with pytest.raises(ValueError, match="particle indices"):
+            b.get_dofs(nodes=bad)
