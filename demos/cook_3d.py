@@ -30,12 +30,12 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
 from skfem_pg import materials as mat
 from skfem_pg.postprocess import particle_fields
 from skfem_pg.reference import overkill
-from skfem_pg.reporting import (print_time_to_target, save_error_vs_time,
-                                wall_time)
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                print_time_to_target, save_error_vs_time,
+                                update_results, wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -83,7 +83,7 @@ def run(sc, name, kw, label, w_ref, rows):
     return r
 
 
-def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
+def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None):
     print(pg.threads.describe())
     ref = overkill(scene(cook3d(16, 4)), refine=0, method="H2")
     w_ref = ref.probes["corner"][2]
@@ -117,6 +117,19 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
             for name in METHODS if name != "O1"))
     print_time_to_target(rows, list(METHODS) + ["H1P0"], 0.01,
                          "corner displacement error")
+    if results:
+        table = [[r["nodes"], r["label"], r["method"], "{:.5f}".format(r["w"]),
+                  "{:.2e}".format(r["err"]),
+                  "{:.2f}".format(wall_time(r))] for r in rows]
+        print("updated", update_results(
+            results, "cook_3d",
+            "`python demos/cook_3d.py --sizes {} --hex {}`: 3-D Cook's "
+            "membrane, iso/vol neo-Hooke, q = {} in z; H2 overkill w = "
+            "{:.5f}; corner error and wall time.\n\n".format(
+                " ".join("{:g}".format(x) for x in sizes),
+                " ".join(str(n) for n in hexes), Q, w_ref)
+            + markdown_table(["nodes", "node set", "method", "w", "error",
+                              "wall time [s]"], table)))
     os.makedirs(OUT, exist_ok=True)
     save_error_vs_time(os.path.join(OUT, "cook_3d.png"), rows, STYLES,
                        "relative error of w(48, 60, 10)",
@@ -129,11 +142,11 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16)):
 
 
 if __name__ == "__main__":
-    ap = demo_parser(__doc__)
+    ap = demo_parser(__doc__, results=True)
     ap.add_argument("--sizes", type=float, nargs="+", default=[5, 3.5, 2.5],
                     help="gmsh mesh sizes of the tetrahedral node sets")
     ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16],
                     help="H1P0 hex grids n x n x n/4")
     args = ap.parse_args()
     OUT = output_dir(args.out)
-    main(args.sizes, args.hex)
+    main(args.sizes, args.hex, args.results)
