@@ -164,13 +164,14 @@ def test_inverted_cells_of_a_particle_displacement(kind):
 def test_horizon_on_strongly_anisotropic_cells_raises():
     """Cells 30:1 and a horizon of 2.01 mean spacings: the families are
     single columns plus a neighbour or two (enlarged until they span the
-    plane) and the VC system is near-singular — |G|·h = 2e19, measured;
-    refused instead of returned."""
+    plane) and the VC system is near-singular — |G|·h = 2e19 measured with
+    scipy 1.17; scipy 1.9's LU calls it exactly singular and the LSQR
+    fallback leaves a residual of 9e-2: refused either way."""
     mesh = fem.MeshQuad.init_tensor(np.linspace(0, 30, 11),
                                     np.linspace(0, 1, 11))
     p = pg.Particles.from_mesh(mesh)
     fam = pg.families.horizon(p, factor=2.01)
-    with pytest.raises(pg.CorrectionError, match="blew"):
+    with pytest.raises(pg.CorrectionError, match="blew|residual"):
         pg.FamilyBasis(p, fam, dim=2)
     # the mesh's own connectivity is fine on the same particles
     r = linear_patch_test(mesh, mesh.facets_satisfying(lambda x: x[1] == 1))
