@@ -42,7 +42,7 @@ from skfem.element import DiscreteField
 from . import families as families_mod
 from . import petrov
 from .corrections import (bond_correction, check_correction,
-                          correction_functions, vc_correction)
+                          correction_functions, family_radii, vc_correction)
 from .errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
@@ -575,9 +575,8 @@ class FamilyBasis(AbstractBasis):
 
     def mesh_parameters(self):
         """Family radius :math:`h_k` at every member."""
-        mem, mask = self.families.padded()
-        P = self.particles.x.T[mem]
-        h = np.sqrt(((P - P[:, :1]) ** 2).sum(-1).max(axis=1))
+        mem, _ = self.families.padded()
+        h = family_radii(self.particles.x, self.families)
         return DiscreteField(np.broadcast_to(h[:, None], mem.shape).copy())
 
     def default_parameters(self):
