@@ -72,6 +72,32 @@ def test_graded_and_sliver_sets_pass_the_patch_test(name, method):
     assert r["basis"].vc_report.residual_after <= 1e-10
 
 
+@pytest.mark.parametrize("name", list(SETS))
+def test_fe_passes_the_patch_test_on_the_same_sets(name):
+    """The sets are valid FE meshes: P1/Q1 pass the same patch test (the
+    reference behaviour the issue names)."""
+    from skfem.helpers import dot
+    from skfem_pg.analysis import PATCH_GRADIENT_2D, PATCH_GRADIENT_3D
+    from skfem_pg.models import lame, linear_elasticity
+    mesh = SETS[name]()
+    d = mesh.dim()
+    e1, _ = pg.particles.linear_elements(mesh)
+    basis = fem.Basis(mesh, fem.ElementVector(e1))
+    lam, mu = lame(100.0, 0.3)
+    G = PATCH_GRADIENT_2D if d == 2 else PATCH_GRADIENT_3D
+    eps = 0.5 * (G + G.T)
+    sigma = 2 * mu * eps + lam * np.trace(eps) * np.eye(d)
+    top = mesh.facets_satisfying(lambda x: x[-1] == 1)
+    fb = fem.FacetBasis(mesh, basis.elem, facets=top)
+    f = fem.LinearForm(lambda v, w: dot(
+        np.einsum("ij,j...->i...", sigma, w.n), v)).assemble(fb)
+    K = linear_elasticity(lam, mu).assemble(basis)
+    D = basis.get_dofs(np.setdiff1d(mesh.boundary_facets(), top))
+    uex = (G @ mesh.p).T.ravel()
+    u = fem.solve(*fem.condense(K, f, x=uex, D=D))
+    assert np.abs(u - uex).max() <= 1e-10
+
+
 def test_the_sets_are_what_they_claim():
     x = SETS["quads graded 1000:1 both ways"]().p[0]
     dx = np.diff(np.unique(x))
