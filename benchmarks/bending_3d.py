@@ -36,7 +36,8 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
+from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+                                update_results)
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture
@@ -46,6 +47,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "demos"))
 from cook_3d import CORNER, T, cook3d  # noqa: E402
 
+RESULTS = os.path.join(HERE, "README.md")  # measured tables, written here
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 LAM, MU = 100.0, 40.0
 MATERIAL = mat.LinearElastic(LAM, MU)
@@ -192,6 +194,17 @@ def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
     energy_table(sets)
     ref = scene(cook3d(16, 4)).solve("H2")
     rows = cook_table(sizes, ref.probes["corner"][2])
+    print("updated", update_results(
+        RESULTS, "bending_3d_linear_cook",
+        "`python benchmarks/bending_3d.py --sizes {}`: linear 3-D Cook "
+        "(plate bending), corner z-displacement against H2 16×16×4 "
+        "(w = {:.6f}), gmsh tetrahedra.\n\n".format(
+            " ".join("{:g}".format(x) for x in sizes),
+            ref.probes["corner"][2])
+        + markdown_table(["nodes", "method", "w", "error", "time [s]"],
+                         [[r["nodes"], r["method"], "{:.6f}".format(r["w"]),
+                           "{:+.2%}".format(r["err"]),
+                           "{:.2f}".format(r["time"])] for r in rows])))
     os.makedirs(OUT, exist_ok=True)
     plot(rows, os.path.join(OUT, "bending_3d.png"))
     print("wrote " + OUT + "/bending_3d.png")
