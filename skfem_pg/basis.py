@@ -120,8 +120,10 @@ class FamilyBasis(AbstractBasis):
     weight_exponent
         ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}` (default 1).
     vc_solver
-        Solver of the VC constraint system: ``"auto"`` = ``"direct"``
-        (scalar sparse LU) or ``"lsqr"``.
+        Solver of the VC constraint system: ``"auto"`` (``"direct"``, in
+        3-D above 15k particles ``"amg"``), ``"direct"`` (scalar sparse
+        LU), ``"amg"`` (the same scalar system by AMG-GMRES, linear in
+        the particle count) or ``"lsqr"``.
     area_vectors
         ``(dim, np)`` surface area vectors :math:`A^i`; default: the
         FE-consistent ones of ``particles.area_vectors()``.

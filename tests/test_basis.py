@@ -116,3 +116,25 @@ def test_vc_falls_back_to_lsqr_when_a_particle_masters_no_family():
         b = pg.FamilyBasis(p, sub, dim=2, vc_tolerance=None)
     assert b.vc_report.solver == "lsqr"
     assert "fell back to LSQR" in b.vc_report.notes[0]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_amg_vc_solve_equals_the_lu(dim, monkeypatch):
+    """The pinned scalar VC system by AMG-GMRES gives the LU's min-norm
+    correction (measured 7e-13 relative on 3.4k gmsh tets), and "auto"
+    takes it in 3-D above AMG_VC_LIMIT_3D particles."""
+    import skfem as fem
+    from skfem_pg import corrections
+    g = np.linspace(0, 1, 9 if dim == 2 else 6)
+    mesh = (fem.MeshTri if dim == 2 else fem.MeshTet).init_tensor(
+        *([g] * dim))
+    mesh = pg.meshing.distort(mesh, 0.25, seed=3)
+    p = pg.Particles.from_mesh(mesh)
+    direct = pg.FamilyBasis(p, dim=dim, vc_solver="direct")
+    amg = pg.FamilyBasis(p, dim=dim, vc_solver="amg")
+    assert amg.vc_report.solver == "amg"
+    assert np.abs(amg.G - direct.G).max() <= 1e-10 * np.abs(direct.G).max()
+    assert amg.vc_report.residual_after < 1e-10
+    monkeypatch.setattr(corrections, "AMG_VC_LIMIT_3D", 10)
+    auto = pg.FamilyBasis(p, dim=dim)
+    assert auto.vc_report.solver == ("amg" if dim == 3 else "direct")
