@@ -59,36 +59,35 @@ def stress(grad, lam, mu):
 
 
 def coupled(mesh, name, lam, mu):
-    """Q1 outside r < R_PG, the named PG formulation inside; returns
-    ``(u, pg_basis, fe_basis, seconds)``."""
+    """Q1 outside r < R_PG, the named PG formulation inside (``name``
+    ``None``: Q1 everywhere); returns ``(u, pg_basis, seconds)``."""
     t0 = time.perf_counter()
-    inner = mesh.elements_satisfying(
-        lambda x: np.hypot(x[0], x[1]) < R_PG)
-    outer = np.setdiff1d(np.arange(mesh.nelements), inner)
     form = linear_elasticity(lam, mu)
-    fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()),
-                   elements=outer)
-    K = pg.assemble(form, fe)
+    element = fem.ElementVector(fem.ElementQuad1())
     pgb = None
-    if name is not None:
+    if name is None:
+        fe = fem.Basis(mesh, element)
+        K = pg.assemble(form, fe)
+    else:
+        inner = mesh.elements_satisfying(
+            lambda x: np.hypot(x[0], x[1]) < R_PG)
+        fe = fem.Basis(mesh, element, elements=np.setdiff1d(
+            np.arange(mesh.nelements), inner))
         pgb = pg.FamilyBasis.from_name(
             pg.Particles.from_mesh(mesh, elements=inner), name, dim=2)
-        K = K + pg.assemble(form, pgb)
-    else:  # Q1 everywhere
-        K = pg.assemble(form, fem.Basis(mesh, fe.elem))
+        K = pg.assemble(form, fe) + pg.assemble(form, pgb)
     fb = fem.FacetBasis(mesh, fe.elem, facets="right")
     f = fem.LinearForm(lambda v, w: SIGMA * v[0]).assemble(fb)
     D = np.concatenate([fe.get_dofs("left").nodal["u^1"],
                         fe.get_dofs("bottom").nodal["u^2"]])
     u = fem.solve(*fem.condense(K, f, D=D))
-    return u, pgb, fe, time.perf_counter() - t0
+    return u, pgb, time.perf_counter() - t0
 
 
 def line_stress(mesh, u, pgb, lam, mu):
     """σ_xx at the mesh nodes on x = 0 and on y = 0 (each sorted along
     the line): PG particles from their master gradients, Q1 nodes from
     the adjacent element's gradient."""
-    q1 = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
     out = {}
     pg_nodes = np.zeros(mesh.nvertices, dtype=bool)
     sxx_pg = np.zeros(mesh.nvertices)
@@ -108,7 +107,6 @@ def line_stress(mesh, u, pgb, lam, mu):
             _, g = ref.evaluate(mesh.p[:, nodes[~on_pg]])
             s[~on_pg] = stress(g, lam, mu)
         out[line] = (mesh.p[1 - axis, nodes], s)
-    del q1
     return out
 
 
@@ -140,7 +138,7 @@ def main(n=16, results=None):
     rows = {}
     for name in (None,) + MODELS:
         label = "Q1" if name is None else name + " + Q1"
-        u, pgb, fe, sec = coupled(mesh, name, lam, mu)
+        u, pgb, sec = coupled(mesh, name, lam, mu)
         lines = line_stress(mesh, u, pgb, lam, mu)
         dev = {}
         for line, (s, v) in lines.items():

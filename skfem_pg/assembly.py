@@ -129,12 +129,10 @@ def _generic(form, *bases, **kwargs):
 
 
 def _view(basis):
-    if isinstance(basis, FamilyBasis):
-        return _FamilyView(basis)
-    if isinstance(basis, fem.CellBasis) and not isinstance(
-            basis.elem, fem.ElementComposite):
-        return _CellView(basis)
-    return None
+    if not supports(basis):
+        return None
+    return (_FamilyView if isinstance(basis, FamilyBasis)
+            else _CellView)(basis)
 
 
 def _probes(view):

@@ -177,6 +177,7 @@ class Particles:
         self.kind = kind
         self.elements = elements
         self._area_vectors = None
+        self._surface_area_vectors = None
         self._validate(allow_inactive=elements is not None)
 
     # -- construction ------------------------------------------------------
@@ -315,7 +316,7 @@ class Particles:
         whole mesh and for centroid particles."""
         if self.kind != "vertices" or self.elements is None:
             return self.area_vectors()
-        if getattr(self, "_surface_area_vectors", None) is None:
+        if self._surface_area_vectors is None:
             self._surface_area_vectors = self.area_vectors(
                 self.outer_facets())
         return self._surface_area_vectors

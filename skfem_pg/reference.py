@@ -18,7 +18,7 @@ import zipfile
 import numpy as np
 import skfem as fem
 
-from .scenes import FE_METHODS, inside
+from .scenes import FE_METHODS, centroid_tree, inside
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
@@ -75,10 +75,10 @@ class Reference:
         _, E = FE_METHODS[method]
         self.basis = fem.Basis(mesh, fem.ElementVector(E()))
         self._finder = mesh.element_finder()
-        self._centroids = mesh.p[:, mesh.t].mean(axis=1)
+        self._tree = centroid_tree(mesh)
 
     def _inside(self, x):
-        return inside(self.mesh, x, self._centroids)
+        return inside(self.mesh, x, self._tree)
 
     def evaluate(self, x):
         """``(values (d, n), gradients (d, d, n))`` at points ``x``."""
@@ -128,7 +128,6 @@ def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
             warnings.warn("the cached overkill reference {} is unreadable "
                           "({}: {}); recomputing it".format(
                               fn, type(err).__name__, err))
-            mesh = scene.mesh.refined(refine) if refine else scene.mesh
     if verbose:
         print("  computing the {} overkill reference on {} elements ..."
               .format(method, mesh.nelements), flush=True)

@@ -270,15 +270,22 @@ class Scene:
         return out
 
 
-def inside(mesh, x, centroids=None):
+def centroid_tree(mesh):
+    """KD-tree of the element centroids (for :func:`inside`)."""
+    from scipy.spatial import cKDTree
+    return cKDTree(mesh.p[:, mesh.t].mean(axis=1).T)
+
+
+def inside(mesh, x, tree=None):
     """Points ``x`` (``(d, n)``) moved by 1e-8 of their distance towards
     the nearest element centroid, so that points on the boundary (a probe
     on a hole, a boundary point of another discretisation of the same
-    straight-sided domain) fall inside ``mesh`` for its element finder."""
-    from scipy.spatial import cKDTree
-    c = mesh.p[:, mesh.t].mean(axis=1) if centroids is None else centroids
-    _, i = cKDTree(c.T).query(np.asarray(x, float).T)
-    return x + 1e-8 * (c[:, i] - x)
+    straight-sided domain) fall inside ``mesh`` for its element finder.
+    ``tree``: a cached :func:`centroid_tree` of ``mesh``."""
+    tree = centroid_tree(mesh) if tree is None else tree
+    x = np.asarray(x, float)
+    _, i = tree.query(x.T)
+    return x + 1e-8 * (tree.data[i].T - x)
 
 
 def _transfer_boundaries(old, new):
