@@ -564,16 +564,17 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
     gh = np.abs(G).max(axis=axes) * family_radii(x, fam)
     if gh.max() > GRADIENT_LIMIT:
         worst = np.argsort(gh)[::-1][:3]
+        why = ("their moment matrices are near-singular" if report is None
+               else "the correction system is near-singular for them "
+               "(residual {:.2e} -> {:.2e})".format(report.residual_before,
+                                                    report.residual_after))
         raise CorrectionError(
             "{} blew the derivatives up: |G|·h = {} in the families of {} "
-            "(limit {:.0e}); the correction system is near-singular for "
-            "these families (residual {:.2e} -> {:.2e}). Use larger or "
-            "better-shaped families, or vc=None.".format(
-                what, ", ".join("{:.2e}".format(gh[k]) for k in worst),
-                "; ".join(describe_particle(masters[k], x[:, masters[k]])
-                          for k in worst), GRADIENT_LIMIT,
-                np.nan if report is None else report.residual_before,
-                np.nan if report is None else report.residual_after))
+            "(limit {:.0e}); {}. Use larger or better-shaped families{}."
+            .format(what, ", ".join("{:.2e}".format(gh[k]) for k in worst),
+                    "; ".join(describe_particle(masters[k], x[:, masters[k]])
+                              for k in worst), GRADIENT_LIMIT, why,
+                    "" if report is None else ", or vc=None"))
     if report is None:
         return
     res = report.residual_after

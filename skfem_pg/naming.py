@@ -52,13 +52,12 @@ def fe_method(name):
     """``"Q1P0"`` for ``"FEM Q1P0"`` (or ``"Q1P0"``); ``None`` if ``name``
     names no FE comparator."""
     parts = name.split()
-    if len(parts) == 2 and parts[0] == "FEM" or len(parts) == 1:
-        if parts[-1] in FE_NAMES:
-            return parts[-1]
-        if parts[0] == "FEM":
-            raise ValueError("unknown FE comparator {!r}: FEM {}".format(
-                name, " / ".join(FE_NAMES)))
-    return None
+    if parts[:1] == ["FEM"]:
+        if len(parts) == 2 and parts[1] in FE_NAMES:
+            return parts[1]
+        raise ValueError("unknown FE comparator {!r}: FEM {}".format(
+            name, " / ".join(FE_NAMES)))
+    return parts[0] if len(parts) == 1 and parts[0] in FE_NAMES else None
 
 
 def parse(name):

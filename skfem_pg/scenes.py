@@ -148,14 +148,12 @@ class Scene:
         for a in (mesh.p, mesh.t):
             h.update(str(a.shape).encode())
             h.update(np.ascontiguousarray(a).tobytes())
-        for name in sorted(mesh.boundaries or {}):
-            h.update(name.encode())
-            h.update(np.sort(np.asarray(mesh.boundaries[name],
-                                        dtype=np.int64)).tobytes())
-        for name in sorted(getattr(mesh, "subdomains", None) or {}):
-            h.update(b"subdomain " + name.encode())
-            h.update(np.sort(np.asarray(mesh.subdomains[name],
-                                        dtype=np.int64)).tobytes())
+        for kind in ("boundaries", "subdomains"):
+            named = getattr(mesh, kind, None) or {}
+            for name in sorted(named):
+                h.update("{} {}".format(kind, name).encode())
+                h.update(np.sort(np.asarray(named[name],
+                                            dtype=np.int64)).tobytes())
         h.update(repr(extra).encode())
         return h.hexdigest()
 
