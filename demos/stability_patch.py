@@ -85,7 +85,7 @@ def simulate(basis, material, stretch, periods, record=8):
     for step in range(n_steps + 1):
         if step % every == 0 or step in snap_at:
             st = model.state(u)
-            W = float(np.sum(basis.dx * material.energy(st["F"])))
+            W = model.energy(st)
             E = W + 0.5 * float(v @ (M * v))
             W0 = E if W0 is None else W0
             out["t"].append(step * dt)

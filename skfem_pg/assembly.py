@@ -21,7 +21,8 @@ scalars).  The local matrices
     \qquad \hat G^{kji} = (N^{kji}, G^{kji}),
 
 (a form may instead provide them as ``form.coefficients(w, c, d + 1)``,
-shape ``(ne, nq, c(d+1), c(d+1))``) are batched matrix products, scattered
+shape ``(ne, nq, c(d+1), c(d+1))``, or as a pair ``(C, channels)`` with
+``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed) are batched matrix products, scattered
 into a block sparsity pattern that is
 computed once per basis.  For a family basis ``k`` is a family, ``j`` a
 member (quadrature point) and ``i`` a member (basis function) with
@@ -42,37 +43,67 @@ from .shape.common import chunks
 from .threads import kernel
 
 
+class _Block:
+    """Elements of equal local size: ``conn`` ``(ne_b, nloc)`` node
+    indices, ``dx`` ``(ne_b, nq)`` weights, ``grads`` the per-element
+    derivative array or callable behind ``ext_grad``, ``take`` the
+    restriction of a quadrature-point array (point axes first) to the
+    block; ``index`` its elements (families) in the basis, ``G`` and
+    ``group`` (family blocks) its unpadded derivatives and size group."""
+
+    def __init__(self, conn, dx, ext_grad, take, index, G=None, group=None):
+        self.conn, self.dx, self.ext_grad, self.take = conn, dx, ext_grad, \
+            take
+        self.index, self.G, self.group = index, G, group
+        self.ne, self.nloc = conn.shape
+        self.nq = dx.shape[1]
+
+
 class _FamilyView:
-    """Local arrays of a :class:`FamilyBasis`."""
+    """Local arrays of a :class:`FamilyBasis`, one block per family size
+    (:mod:`skfem_pg.layout`): no padding."""
 
     def __init__(self, basis):
         self.basis = basis
-        self.conn, self.mask = basis.families.padded()
-        self.nq = self.nloc = self.conn.shape[1]
+        self.layout = L = basis.layout
         self.dim = basis.particles.dim
         self.scalar = basis.ncomp is None
         self.nc = 1 if self.scalar else basis.ncomp
         self.n_nodes = basis.particles.n
-        self.dx = basis.dx
+        self.shape = (L.n_families, L.m_max)
+        self.blocks = [
+            _Block(g.members, dx, self._ext_grad(G),
+                   (lambda C, g=g: L.take(C, g, axis=0)), g.families, G, g)
+            for g, G, dx in zip(L, basis.grouped_gradients(),
+                                basis.grouped_weights())]
 
-    def ext_grad(self, sl, channels):
-        """``Ĝ[k, j, i, β]`` for families ``sl``; β over ``channels``."""
-        G = self.basis.G[sl]
-        nfc, m = G.shape[:2]
-        parts = []
-        for beta in channels:
-            if beta == 0:
-                parts.append(np.broadcast_to(
-                    np.eye(m) * self.mask[sl][:, None, :], (nfc, m, m)))
-            else:
-                parts.append(G[..., beta - 1])
-        return np.stack(parts, axis=-1)
+    @staticmethod
+    def _ext_grad(G):
+        m = G.shape[1]
+
+        def ext_grad(sl, channels):
+            """``Ĝ[k, j, i, β]`` for families ``sl``; β over
+            ``channels``."""
+            Gs = G[sl]
+            parts = [np.broadcast_to(np.eye(m), Gs.shape[:3]) if beta == 0
+                     else Gs[..., beta - 1] for beta in channels]
+            return np.stack(parts, axis=-1)
+        return ext_grad
+
+    def coefficient_shape(self, shapes):
+        """Quadrature axes of the form's values: padded ``(nf, m_max)`` or
+        flat ``(1, N_q)``."""
+        for sh in shapes:
+            if len(sh) >= 2 and self.layout.is_flat(sh[-2:]):
+                return (1, self.layout.n_points)
+        return self.shape
 
 
 class _CellView:
     """Local arrays of a scikit-fem ``CellBasis`` (scalar element or
     ``ElementVector`` of one): elements, quadrature points and the scalar
-    shape functions, whose dof ``s`` carries vector dofs ``c·s + a``."""
+    shape functions, whose dof ``s`` carries vector dofs ``c·s + a``; one
+    block."""
 
     def __init__(self, basis):
         elem = basis.elem
@@ -87,29 +118,32 @@ class _CellView:
                 quadrature=basis.quadrature, elements=basis.tind)
             basis._pg_scalar_basis = sb
         self.sb = sb
-        self.conn = sb.element_dofs.T
-        self.mask = np.ones(self.conn.shape, dtype=bool)
-        self.nloc = self.conn.shape[1]
-        self.nq = basis.dx.shape[1]
+        conn = sb.element_dofs.T
         self.dim = basis.mesh.dim()
         self.n_nodes = sb.N
-        self.dx = basis.dx
-        expected = (self.nc * self.conn[:, :, None]
-                    + np.arange(self.nc)).reshape(len(self.conn), -1).T
+        self.shape = basis.dx.shape
+        self.blocks = [_Block(conn, basis.dx, self._ext_grad,
+                              lambda C: C, np.arange(len(conn)))]
+        expected = (self.nc * conn[:, :, None]
+                    + np.arange(self.nc)).reshape(len(conn), -1).T
         if vector and not np.array_equal(expected, basis.element_dofs):
             raise NotImplementedError("unexpected vector dof numbering")
 
-    def ext_grad(self, sl, channels):
+    def _ext_grad(self, sl, channels):
+        nloc = self.blocks[0].nloc
         parts = []
         for beta in channels:
             if beta == 0:
                 v = [np.asarray(self.sb.basis[i][0])[sl]
-                     for i in range(self.nloc)]
+                     for i in range(nloc)]
             else:
                 v = [self.sb.basis[i][0].grad[beta - 1][sl]
-                     for i in range(self.nloc)]
+                     for i in range(nloc)]
             parts.append(np.stack(v, axis=-1))  # (k, q, i)
         return np.stack(parts, axis=-1)
+
+    def coefficient_shape(self, shapes):
+        return self.shape
 
 
 def supports(basis):
@@ -154,12 +188,15 @@ def _probes(view):
     return out
 
 
-def _coefficients(values, shape):
-    """Stack form values; constant coefficients stay ``(P, Q)``."""
+def _coefficients(values, view):
+    """Stack form values; constant coefficients stay ``(P, Q)``, others
+    get the view's quadrature axes first: padded / cell ``(ne, nq)`` or
+    flat ``(1, N_q)``."""
     arrs = [[np.asarray(v, dtype=float) for v in row] for row in values]
     if all(a.size == 1 for row in arrs for a in row):
         return np.array([[float(a.ravel()[0]) for a in row] for row in arrs]), \
             True
+    shape = view.coefficient_shape([a.shape for row in arrs for a in row])
     out = np.empty(shape + (len(arrs), len(arrs[0])))
     for p, row in enumerate(arrs):
         for q, a in enumerate(row):
@@ -215,68 +252,104 @@ def _call(form, *args):
 
 def block_pattern(basis, view=None):
     """Node-level sparsity pattern of the basis, computed once and cached
-    on it: CSR ``indptr`` and ``indices``, and for each chunk of elements
-    the distinct block indices ``u`` it touches and, per local pair
-    ``(row node l, column node i)``, its index ``inv`` into ``u``."""
+    on it: CSR ``indptr`` and ``indices``, and per block and chunk of its
+    elements ``(block, slice, u, inv)``: the distinct block indices ``u``
+    the chunk touches and, per local pair ``(row node l, column node i)``,
+    its index ``inv`` into ``u``."""
     if getattr(basis, "_pattern", None) is None:
         view = _view(basis) if view is None else view
-        conn, mask = view.conn, view.mask
-        ne, m = conn.shape
         n = view.n_nodes
-        E = sp.csr_matrix((np.ones(mask.sum()),
-                           (np.broadcast_to(np.arange(ne)[:, None],
-                                            conn.shape)[mask], conn[mask])),
-                          shape=(ne, n))
+        rows_e, cols_n = [], []
+        start = 0
+        for blk in view.blocks:
+            rows_e.append(np.repeat(np.arange(start, start + blk.ne),
+                                    blk.nloc))
+            cols_n.append(blk.conn.ravel())
+            start += blk.ne
+        E = sp.csr_matrix((np.ones(sum(len(r) for r in rows_e)),
+                           (np.concatenate(rows_e), np.concatenate(cols_n))),
+                          shape=(start, n))
         S = (E.T @ E).tocsr()
         S.sort_indices()
         rows = np.repeat(np.arange(n, dtype=np.int64), np.diff(S.indptr))
         keys = rows * n + S.indices
         pieces = []
-        for sl in chunks(ne, view.nq * m * view.nc ** 2 * (view.dim + 1),
-                         budget=2 ** 24):
-            loc = (conn[sl, :, None].astype(np.int64) * n
-                   + conn[sl, None, :]).ravel()
-            u, inv = np.unique(np.searchsorted(keys, loc),
-                               return_inverse=True)
-            pieces.append((sl, u, inv.astype(np.int64)))
-        basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces)
+        for bi, blk in enumerate(view.blocks):
+            conn, m = blk.conn, blk.nloc
+            for sl in chunks(blk.ne, blk.nq * m * view.nc ** 2
+                             * (view.dim + 1), budget=2 ** 24):
+                loc = (conn[sl, :, None].astype(np.int64) * n
+                       + conn[sl, None, :]).ravel()
+                u, inv = np.unique(np.searchsorted(keys, loc),
+                                   return_inverse=True)
+                pieces.append((bi, sl, u, inv.astype(np.int64)))
+        basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces, {})
     return basis._pattern
+
+
+def _scatter_index(u, inv, m, nc, transposed):
+    """Entry-level scatter of one chunk: for local matrices laid out
+    ``(k, l, i, c_l, c_i)`` (or ``(k, c_i, i, c_l, l)`` if
+    ``transposed``), the index of every entry into the chunk's
+    ``nc²·len(u)`` data entries, and those entries' positions in the
+    ``(nnz_blocks, nc, nc)`` data array."""
+    n2 = nc * nc
+    dtype = np.int32 if len(u) * n2 < 2 ** 31 else np.int64
+    b = inv.reshape(-1, m, m).astype(dtype) * n2  # (k, l, i)
+    cc = np.arange(nc, dtype=dtype)
+    if transposed:  # [k, a, i, c, l] -> inv[k, l, i] n2 + c nc + a
+        idx = (b.transpose(0, 2, 1)[:, None, :, None, :]
+               + cc[None, :, None, None, None]
+               + nc * cc[None, None, None, :, None])
+    else:  # [k, l, i, c, a]
+        idx = (b[..., None, None] + nc * cc[:, None] + cc[None, :])
+    full = (u[:, None] * n2 + np.arange(n2)).ravel()
+    return idx.ravel(), full
 
 
 def _assemble_bilinear(form, basis, view, vview, kwargs):
     w, probes = _setup(form, basis, view, kwargs)
-    ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
+    nc = view.nc
     nch = view.dim + 1
     # C[p, q]: p = trial probe (a, β), q = test probe (c, γ)
+    ch = None
     if hasattr(form, "coefficients"):  # the form knows them: no probing
-        C, const = form.coefficients(w, view.nc, nch), False
+        C = form.coefficients(w, view.nc, nch)
+        if isinstance(C, tuple):  # already restricted to its channels
+            C, ch = C
+        const = False
     else:
         values = [[_call(form, pu, pv, w) for (_, _, pv) in probes]
                   for (_, _, pu) in probes]
-        C, const = _coefficients(values, (ne, nq))
-    ch = _used_channels(C, nc, nch)
-    sel = [a * nch + b for a in range(nc) for b in ch]
-    C = C[..., sel, :][..., :, sel]
+        C, const = _coefficients(values, view)
+    if ch is None:
+        ch = _used_channels(C, nc, nch)
+        sel = [a * nch + b for a in range(nc) for b in ch]
+        C = C[..., sel, :][..., :, sel]
     nb = len(ch)
+    Cb = {}  # coefficients per block
 
-    def local_matrices(sl):
-        Gh = view.ext_grad(sl, ch)  # trial (k, j, i, β)
-        Gv = Gh if vview is view else vview.ext_grad(sl, ch)  # test
-        nfc = Gh.shape[0]
+    def local_matrices(bi, blk, sl):
+        Gh = blk.ext_grad(sl, ch)  # trial (k, j, i, β)
+        Gv = Gh if vview is view else vview.blocks[bi].ext_grad(sl, ch)
+        nfc, nq, m = Gh.shape[:3]
         # GT[k, i, (j, β)] = w_kj Ĝ[k, j, i, β]
-        GT = (Gh * view.dx[sl][:, :, None, None]).transpose(0, 2, 1, 3) \
+        GT = (Gh * blk.dx[sl][:, :, None, None]).transpose(0, 2, 1, 3) \
             .reshape(nfc, 1, m, nq * nb)
         # Ca[k, a, j, (β, c), γ] = C[k, j, (a, β), (c, γ)]
         if const:
             Ca = C.reshape(1, nc, 1, nb * nc, nb)
         else:
-            Ca = C[sl].reshape(nfc, nq, nc, nb * nc, nb).transpose(
+            if bi not in Cb:
+                Cb.clear()
+                Cq = blk.take(C)  # one gather, contiguous
+                Cb[bi] = Cq.reshape(Cq.shape[:2] + (nc * nb, nc * nb))
+            Ca = Cb[bi][sl].reshape(nfc, nq, nc, nb * nc, nb).transpose(
                 0, 2, 1, 3, 4)
         # Y[k, a, (j, β), (c, l)]
         #     = sum_γ Ca[k, a, j, (β, c), γ] Ĝv[k, j, l, γ]  (test)
-        Y = np.empty((nfc, nc, nq, nb * nc, m))  # matmul's own output
-        np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None], out=Y)  # may be
-        Y = Y.reshape(nfc, nc, nq * nb, nc * m)  # strided: reshape copies
+        Y = np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None])
+        Y = Y.reshape(nfc, nc, nq * nb, nc * m)
         # K[k, a, i, c, l]
         #     = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
         return np.matmul(GT, Y).reshape(nfc, nc, m, nc, m)
@@ -288,56 +361,64 @@ def _assemble_bilinear(form, basis, view, vview, kwargs):
 def assemble_local(basis, local_matrices, view=None, transposed=False):
     """Sparse matrix from local element/family matrices.
 
-    ``local_matrices(sl)`` returns, for the elements ``sl``, an array of
-    shape ``(ne, m, m, c, c)``: block ``[k, l, i]`` couples row node ``l``
-    (test) with column node ``i`` (trial), components ``[c_l, c_i]``.
-    With ``transposed=True`` it returns the component-major transpose
-    ``(ne, c, m, c, m)`` indexed ``[k, c_i, i, c_l, l]`` instead (what a
-    batched product yields without a strided copy).  Blocks are summed
-    into the cached :func:`block_pattern`.
+    ``local_matrices(b, block, sl)`` returns, for the elements ``sl`` of
+    block ``b`` (``block.conn``: their nodes; a :class:`FamilyBasis` has a
+    block per family size, ``block.G`` its unpadded derivatives and
+    ``block.group`` its :class:`~skfem_pg.layout.Group`), an array of
+    shape ``(ne, m, m, c, c)``: entry ``[k, l, i]`` couples row node
+    ``l`` (test) with column node ``i`` (trial), components
+    ``[c_l, c_i]``.  With ``transposed=True`` it returns the
+    component-major transpose ``(ne, c, m, c, m)`` indexed
+    ``[k, c_i, i, c_l, l]`` instead (what a batched product yields
+    without a strided copy).  Entries are summed into the cached
+    :func:`block_pattern` through one precomputed scatter index per chunk
+    (one ``bincount`` each).
     """
     view = _view(basis) if view is None else view
     nc = view.nc
-    indptr, indices, pieces = block_pattern(basis, view)
-    data = np.zeros((len(indices), nc, nc))
-    for sl, u, inv in pieces:
-        K = local_matrices(sl)
-        if transposed:
-            m = K.shape[2]
-            inv = inv.reshape(-1, m, m).transpose(0, 2, 1).ravel()
-        for c in range(nc):
-            for a in range(nc):
-                Kca = K[:, a, :, c, :] if transposed else K[..., c, a]
-                data[u, c, a] += np.bincount(inv, weights=Kca.ravel(),
-                                             minlength=len(u))
+    indptr, indices, pieces, scatter = block_pattern(basis, view)
+    if transposed not in scatter:
+        scatter[transposed] = [
+            _scatter_index(u, inv, view.blocks[bi].nloc, nc, transposed)
+            for bi, sl, u, inv in pieces]
+    data = np.zeros(len(indices) * nc * nc)
+    for (bi, sl, u, inv), (idx, full) in zip(pieces, scatter[transposed]):
+        K = local_matrices(bi, view.blocks[bi], sl)
+        data[full] += np.bincount(idx, weights=K.ravel(),
+                                  minlength=len(full))
     N = basis.N
     if nc == 1:
-        return sp.csr_matrix((data[:, 0, 0], indices, indptr), shape=(N, N))
-    return sp.bsr_matrix((data, indices, indptr), shape=(N, N)).tocsr()
+        return sp.csr_matrix((data, indices, indptr), shape=(N, N))
+    return sp.bsr_matrix((data.reshape(-1, nc, nc), indices, indptr),
+                         shape=(N, N)).tocsr()
 
 
 def _assemble_linear(form, basis, view, kwargs):
     w, probes = _setup(form, basis, view, kwargs)
-    ne, nq, m, nc = len(view.conn), view.nq, view.nloc, view.nc
+    nc = view.nc
     nch = view.dim + 1
     values = [[_call(form, pv, w) for (_, _, pv) in probes]]
-    C, const = _coefficients(values, (ne, nq))
-    C = C[..., 0, :]  # (P,) or (ne, nq, P)
+    C, const = _coefficients(values, view)
+    C = C[..., 0, :]  # (P,) or (points..., P)
     b = np.zeros(basis.N)
-    for sl in chunks(ne, nq * m * nc * nch, budget=2 ** 24):
-        Gh = view.ext_grad(sl, range(nch))
-        dx = view.dx[sl]
-        Cs = C if const else C[sl]
-        Cs = np.broadcast_to(Cs, dx.shape + (nc * nch,)) \
-            .reshape(dx.shape + (nc, nch))
-        # f[k, l, c] = sum_j dx sum_γ C[k, j, c, γ] Ĝ[k, j, l, γ]
-        nfc = dx.shape[0]
-        X = (dx[..., None, None] * Cs).transpose(0, 2, 1, 3) \
-            .reshape(nfc, nc, nq * nch)
-        Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nch, m)
-        f = np.swapaxes(X @ Gm, -1, -2)
-        dofs = nc * view.conn[sl][:, :, None] + np.arange(nc)
-        b += np.bincount(dofs.ravel(), weights=f.ravel(), minlength=basis.N)
+    for blk in view.blocks:
+        Cblk = C if const else blk.take(C)
+        m, nq = blk.nloc, blk.nq
+        for sl in chunks(blk.ne, nq * m * nc * nch, budget=2 ** 24):
+            Gh = blk.ext_grad(sl, range(nch))
+            dx = blk.dx[sl]
+            nfc = dx.shape[0]
+            Cs = np.broadcast_to(Cblk if const else Cblk[sl],
+                                 dx.shape + (nc * nch,)) \
+                .reshape(dx.shape + (nc, nch))
+            # f[k, l, c] = sum_j dx sum_γ C[k, j, c, γ] Ĝ[k, j, l, γ]
+            X = (dx[..., None, None] * Cs).transpose(0, 2, 1, 3) \
+                .reshape(nfc, nc, nq * nch)
+            Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nch, m)
+            f = np.swapaxes(X @ Gm, -1, -2)
+            dofs = nc * blk.conn[sl][:, :, None] + np.arange(nc)
+            b += np.bincount(dofs.ravel(), weights=f.ravel(),
+                             minlength=basis.N)
     return b
 
 

@@ -26,8 +26,11 @@ scikit-fem's ``form.assemble(basis, basis.test)``.
 Degrees of freedom follow scikit-fem's nodal numbering of the mesh the
 particles were collocated from (vector dof ``c`` of particle ``p`` is
 ``dim * p + c``), so family bases and FE bases on the same mesh add into one
-system.  Families are padded to the largest size ``m``; padded slots have
-zero weight and zero gradient.
+system.  ``G`` and ``dx`` are padded to the largest family size ``m``
+(padded slots have zero weight and zero gradient) for scikit-fem's generic
+assembly; the batched hot paths (:func:`skfem_pg.assemble`,
+``interpolate``, the models) use the unpadded size groups of
+:mod:`skfem_pg.layout` instead.
 """
 import copy
 import sys
@@ -384,6 +387,7 @@ class FamilyBasis(AbstractBasis):
         self.W = np.ones(m)
         self._basis = None
         self._pattern = None
+        self._groups_cache = None
         self.trial = None  # set on a PPG test basis: its trial basis
         if ppg:
             self.test = copy.copy(self)
@@ -469,11 +473,43 @@ class FamilyBasis(AbstractBasis):
         Gr[c] = grad
         return (DiscreteField(V, Gr),)
 
+    @property
+    def layout(self):
+        """:class:`~skfem_pg.layout.SizeGroups` of the families: the
+        unpadded layout of the hot paths."""
+        return self.families.groups()
+
+    def grouped_gradients(self):
+        """``G`` without padding: per size group ``(nf_b, m, m, d)``
+        (cached; ``G`` is not to be modified after construction)."""
+        if self._groups_cache is None or self._groups_cache[0] is not self.G:
+            L = self.layout
+            self._groups_cache = (self.G, [
+                np.ascontiguousarray(self.G[g.families, :g.m, :g.m])
+                for g in L], [L.take(self.dx, g) for g in L])
+        return self._groups_cache[1]
+
+    def flat_weights(self):
+        """``dx`` in the flat layout, ``(1, N_q)``."""
+        return self.layout.padded_to_flat(self.dx)[None]
+
+    def grouped_weights(self):
+        """``dx`` without padding: per size group ``(nf_b, m)``."""
+        self.grouped_gradients()
+        return self._groups_cache[2]
+
     @kernel
-    def interpolate(self, w):
+    def interpolate(self, w, flat=False):
         r"""Values and gradients of the nodal field ``w`` at the members:
         value :math:`u^j`, gradient :math:`\sum_i u^i\otimes G^{kji}`
-        (so :math:`F = I + \text{grad}` for displacements)."""
+        (so :math:`F = I + \text{grad}` for displacements).
+
+        Padded trailing axes ``(nf, m_max)`` (what scikit-fem's generic
+        assembly needs; zero in padded slots), or with ``flat=True`` the
+        unpadded ``(1, N_q)`` of :mod:`skfem_pg.layout`, which
+        :func:`skfem_pg.assemble` accepts too and which material models
+        evaluate without the padding.
+        """
         if self.trial is not None:
             raise ValueError(
                 "interpolate() on the test basis of a Petrov–Galerkin "
@@ -484,17 +520,24 @@ class FamilyBasis(AbstractBasis):
         if w.shape[0] != self.N:
             raise ValueError("Input array has wrong size: {} != N = {}"
                              .format(w.shape[0], self.N))
-        mem, mask = self.families.padded()
+        L = self.layout
+        nc = 1 if self.ncomp is None else self.ncomp
+        d = self.particles.dim
+        W = w.reshape(-1, nc)
+        value = np.empty((nc, L.n_points))
+        grad = np.empty((nc, d, L.n_points))
+        for g, G in zip(L, self.grouped_gradients()):
+            U = W[g.members]  # (nf_b, m, nc)
+            value[:, g.flat] = np.moveaxis(U, -1, 0)
+            gr = np.swapaxes(G, -1, -2) @ U[:, None]  # (nf_b, m, d, nc)
+            grad[:, :, g.flat] = gr.transpose(3, 2, 0, 1)
+        if flat:
+            value, grad = value[..., None, :], grad[..., None, :]
+        else:
+            value, grad = L.flat_to_padded(value), L.flat_to_padded(grad)
         if self.ncomp is None:
-            U = w[mem]
-            value = U * mask
-            grad = (np.swapaxes(self.G, -1, -2) @ U[:, None, :, None])
-            return DiscreteField(value, np.moveaxis(grad[..., 0], -1, 0))
-        nc = self.ncomp
-        U = w.reshape(-1, nc)[mem]  # (nf, m, nc)
-        value = np.moveaxis(U * mask[..., None], -1, 0)
-        grad = np.swapaxes(self.G, -1, -2) @ U[:, None]  # (nf, m, d, nc)
-        return DiscreteField(value, grad.transpose(3, 2, 0, 1))
+            value, grad = value[0], grad[0]
+        return DiscreteField(value, grad)
 
     # -- scikit-fem idioms -------------------------------------------------
     def _collocation_basis(self, what):

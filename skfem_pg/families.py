@@ -3,7 +3,8 @@ r"""Particle families :math:`H^k` — the "elements" of a PG method.
 A family is an ordered list of particle indices, **master first**
 (formulas.md section 1).  :class:`Families` stores them ragged (CSR-like
 ``offsets``/``members``) and hands out a padded ``(nf, m)`` view with a mask
-for the batched shape-function kernels.
+for the batched shape-function kernels and the unpadded size groups of
+:mod:`skfem_pg.layout` for the hot paths.
 
 Builders
 --------
@@ -57,6 +58,7 @@ class Families:
         if len(np.unique(self.masters)) != len(self):
             raise FamilyError("two families have the same master")
         self._padded = None
+        self._groups = None
 
     def __len__(self):
         return len(self.offsets) - 1
@@ -85,6 +87,14 @@ class Families:
             mem[mask] = self.members
             self._padded = (mem, mask)
         return self._padded
+
+    def groups(self):
+        """The unpadded layout: :class:`~skfem_pg.layout.SizeGroups` of
+        the families (cached)."""
+        if self._groups is None:
+            from .layout import SizeGroups
+            self._groups = SizeGroups(self)
+        return self._groups
 
     def __repr__(self):
         s = self.sizes

@@ -52,14 +52,14 @@ def material_tangent(du, v, w):
 
 
 def _tangent_coefficients(w, nc, nch):
-    """Probe coefficients of :func:`material_tangent` for the batched
-    assembly: trial ``(a, 1+b)``, test ``(c, 1+e)`` -> ``A[c, e, a, b]``;
-    values do not enter."""
+    """Coefficients of :func:`material_tangent` for the batched assembly,
+    on the gradient channels only: trial ``(a, 1+b)``, test ``(c, 1+e)``
+    -> ``A[c, e, a, b]``, as a view ``(points..., a, b, c, e)`` of ``w.A``
+    (the assembly gathers it per block, one copy)."""
     A = np.asarray(w.A)
     d = A.shape[0]
-    C = np.zeros(A.shape[4:] + (nc, nch, nc, nch))
-    C[..., :, 1:, :, 1:] = np.moveaxis(A, (0, 1, 2, 3), (-2, -1, -4, -3))
-    return C.reshape(A.shape[4:] + (nc * nch, nc * nch))
+    return (np.moveaxis(A, (0, 1, 2, 3), (-2, -1, -4, -3)),
+            list(range(1, d + 1)))
 
 
 material_tangent.coefficients = _tangent_coefficients
@@ -94,7 +94,19 @@ class Hyperelastic:
 
     @kernel
     def state(self, u):
+        """``{"F": ...}`` at the quadrature points: for a family basis in
+        the unpadded flat layout ``(d, d, 1, N_q)`` (:mod:`skfem_pg.layout`),
+        so the material is evaluated only at real members."""
+        if hasattr(self.basis, "layout"):
+            return {"F": self.basis.interpolate(u, flat=True).grad
+                    + self._eye}
         return {"F": self.basis.interpolate(u).grad + self._eye}
+
+    def energy(self, state):
+        """Stored energy :math:`\\sum w\\, W(F)` of ``state``."""
+        dx = (self.basis.flat_weights() if hasattr(self.basis, "layout")
+              else self.basis.dx)
+        return float(np.sum(dx * self.material.energy(state["F"])))
 
     def min_J(self, state):
         return float(_det(state["F"]).min())
