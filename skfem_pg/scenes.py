@@ -202,6 +202,19 @@ class Scene:
         :mod:`skfem_pg.naming`; ``basis_kwargs`` override it) or an FE
         method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``); returns a
         :class:`Result`."""
+        basis, model, f, D, u_D, t_pre = self.setup(
+            scheme, mesh, tangent, **basis_kwargs)
+        u, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
+                         solver=solver, verbose=verbose)
+        times = {"preprocess": t_pre,
+                 "assemble": sum(h["t_assemble"] for h in hist),
+                 "solve": sum(h["t_linear"] for h in hist)}
+        return Result(scheme, u, basis, self.evaluate(basis, u), times, hist)
+
+    def setup(self, scheme="PG", mesh=None, tangent="consistent",
+              **basis_kwargs):
+        """What :meth:`solve` hands Newton's method: ``(basis, model,
+        f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`)."""
         from .naming import fe_method, parse
         method = fe_method(scheme) or scheme
         t0 = time.perf_counter()
@@ -241,13 +254,7 @@ class Scene:
             raise ValueError("unknown method {!r}: 'PG' or one of {}".format(
                 method, ", ".join(FE_METHODS)))
         D, u_D = self._dirichlet(basis)
-        t_pre = time.perf_counter() - t0
-        u, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
-                         solver=solver, verbose=verbose)
-        times = {"preprocess": t_pre,
-                 "assemble": sum(h["t_assemble"] for h in hist),
-                 "solve": sum(h["t_linear"] for h in hist)}
-        return Result(scheme, u, basis, self.evaluate(basis, u), times, hist)
+        return basis, model, f, D, u_D, time.perf_counter() - t0
 
     def evaluate(self, basis, u):
         """Displacements at the probe points."""

@@ -49,24 +49,46 @@ def rigid_body_modes(doflocs):
     return np.column_stack([m.ravel() for m in modes])
 
 
-def direct(A, b, ordering="rcm+mmd", **kwargs):
-    """Sparse direct solve (SuperLU) for FE and PG systems alike.
+def pardiso_available():
+    """Whether ``pypardiso`` (Intel MKL PARDISO; ``pip install
+    skfem-pg[pardiso]``) can be imported."""
+    try:
+        import pypardiso  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
-    ``ordering="rcm+mmd"``: reverse Cuthill–McKee permutation, then
-    SuperLU's ``MMD_AT_PLUS_A``; measured on 14k–80k dof 2-D elasticity
-    systems (gmsh triangles, distorted grids; T1/Q1 and PG) the fastest of
-    scipy's options or within 1.3x of it, while each SuperLU ordering
-    alone is up to 27x slower on one of them.  ``ordering="colamd"``:
-    SuperLU's ``COLAMD``; on 3-D Cook tetrahedra (3.7k / 9.7k dof) 2.1x /
-    4.4x faster than ``rcm+mmd`` for O1 and 0.8x / 2.7x for PG.
-    Usable as ``fem.solve(A, b, solver=direct)``.
+
+def direct(A, b, ordering="auto", **kwargs):
+    """Sparse direct solve for FE and PG systems alike.
+
+    ``ordering="auto"``: MKL PARDISO if ``pypardiso`` is installed (3-D
+    Cook tetrahedra, 11k unknowns: PG 1.3 s against 5.0 s for SuperLU
+    with COLAMD, O1 0.33 s against 1.4 s; benchmarks/README.md), else
+    ``"rcm+mmd"``.  ``"pardiso"``: MKL PARDISO (its own nested-dissection
+    ordering, MKL's threads).  ``ordering="rcm+mmd"``: reverse
+    Cuthill–McKee permutation, then SuperLU's ``MMD_AT_PLUS_A``; measured
+    on 14k–80k dof 2-D elasticity systems (gmsh triangles, distorted
+    grids; T1/Q1 and PG) the fastest of scipy's options or within 1.3x of
+    it, while each SuperLU ordering alone is up to 27x slower on one of
+    them.  ``ordering="colamd"``: SuperLU's ``COLAMD``; on 3-D Cook
+    tetrahedra (3.7k / 9.7k dof) 2.1x / 4.4x faster than ``rcm+mmd`` for
+    O1 and 0.8x / 2.7x for PG.  Usable as ``fem.solve(A, b,
+    solver=direct)``.
     """
     A = A.tocsr()
+    if ordering == "auto":
+        ordering = "pardiso" if pardiso_available() else "rcm+mmd"
+    if ordering == "pardiso":
+        import pypardiso
+        x = pypardiso.spsolve(A, np.asarray(b, dtype=float))
+        pypardiso.ps.free_memory(everything=True)
+        return x
     if ordering == "colamd":
         return spl.spsolve(A.tocsc(), b, permc_spec="COLAMD")
     if ordering != "rcm+mmd":
-        raise ValueError("ordering must be 'rcm+mmd' or 'colamd', got {!r}"
-                         .format(ordering))
+        raise ValueError("ordering must be 'auto', 'pardiso', 'rcm+mmd' or "
+                         "'colamd', got {!r}".format(ordering))
     from scipy.sparse.csgraph import reverse_cuthill_mckee
     p = reverse_cuthill_mckee(A, symmetric_mode=True)
     x = np.empty_like(b, dtype=float)
@@ -80,23 +102,126 @@ def direct(A, b, ordering="rcm+mmd", **kwargs):
 DIRECT_LIMIT = {2: 60_000, 3: 10_000}
 
 
+def _node_blocks(doflocs):
+    """Node block size ``d`` if the condensed dofs come in whole nodes
+    (``d`` consecutive dofs at one location), else 1."""
+    d, n = doflocs.shape
+    if n % d:
+        return 1
+    X = doflocs.reshape(d, -1, d)
+    return d if np.all(X == X[:, :, :1]) else 1
+
+
+class AMGSolver:
+    """CG (GMRES if not ``symmetric``) preconditioned by pyamg smoothed
+    aggregation with rigid-body modes, for a sequence of related systems
+    (Newton's tangents).
+
+    * The hierarchy is kept and reused while it works: it is rebuilt when
+      the Krylov iterations exceed ``rebuild`` times those right after the
+      last build, or when the reused one fails.
+    * Aggregation by nodes (BSR blocks of ``d`` dofs) when the condensed
+      dofs come in whole nodes; prolongator smoothing ``smooth`` (default
+      ``"energy"``: on 3-D Cook PG tangents 50 CG iterations against 65
+      for Jacobi smoothing, benchmarks/README.md).
+    * Fallback chain, costing at most one failed Krylov attempt more than
+      the direct solve: a failed solve with a fresh hierarchy goes to the
+      direct solve (with a warning) when the system has at most
+      ``direct_limit`` unknowns; above it, to GMRES with the same
+      hierarchy (CG fails on indefinite tangents, e.g. past a limit
+      point), then to the direct solve.
+
+    ``stats`` counts builds, solves, iterations and fallbacks.
+    """
+
+    def __init__(self, doflocs=None, tol=1e-10, symmetric=True,
+                 smooth="energy", rebuild=1.5, maxiter=500,
+                 direct_limit=4 * DIRECT_LIMIT[3], ordering="auto"):
+        self.doflocs, self.tol, self.symmetric = doflocs, tol, symmetric
+        self.smooth, self.rebuild, self.maxiter = smooth, rebuild, maxiter
+        self.direct_limit, self.ordering = direct_limit, ordering
+        self.ml, self.base_its = None, None
+        self.stats = {"builds": 0, "solves": 0, "iterations": [],
+                      "fallbacks": 0, "setup_seconds": 0.0}
+
+    def _build(self, A):
+        import pyamg
+        t0 = time.perf_counter()
+        locs = self.doflocs
+        B = rigid_body_modes(locs) if locs is not None else None
+        bs = _node_blocks(locs) if locs is not None else 1
+        M = A.tobsr(blocksize=(bs, bs)) if bs > 1 else A
+        self.ml = pyamg.smoothed_aggregation_solver(
+            M, B=B, smooth=self.smooth,
+            symmetry="hermitian" if self.symmetric else "nonsymmetric")
+        self.base_its = None
+        self.stats["builds"] += 1
+        self.stats["setup_seconds"] += time.perf_counter() - t0
+
+    def _krylov(self, A, b, accel, x0=None):
+        res = []
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # CG's indefinite note
+            x = self.ml.solve(b, x0=x0, tol=self.tol, accel=accel,
+                              maxiter=min(self.maxiter, A.shape[0]),
+                              residuals=res)
+        bn = max(np.linalg.norm(b), 1e-300)
+        rel = np.linalg.norm(b - A @ x) / bn  # the true residual
+        # preconditioned vs true residual
+        return x, len(res), rel <= 1e3 * self.tol, rel
+
+    def __call__(self, A, b, **kwargs):
+        A = A.tocsr()
+        self.stats["solves"] += 1
+        fresh = self.ml is None or self.ml.levels[0].A.shape != A.shape
+        if fresh:
+            self._build(A)
+        accel = "cg" if self.symmetric else "gmres"
+        x, its, ok, rel = self._krylov(A, b, accel)
+        if not fresh and (not ok or (self.base_its is not None and its
+                                     > self.rebuild * self.base_its + 5)):
+            self._build(A)  # stale: rebuild, continue from x if useful
+            fresh = True
+            x, its2, ok, rel = self._krylov(A, b, accel, x0=x if ok else None)
+            its += its2
+        if ok and fresh:
+            self.base_its = its
+        self.stats["iterations"].append(its)
+        if ok:
+            return x
+        self.stats["fallbacks"] += 1
+        if A.shape[0] > self.direct_limit and accel == "cg":
+            x, its, ok, rel = self._krylov(A, b, "gmres")
+            self.stats["iterations"][-1] += its
+            if ok:
+                return x
+        warnings.warn("AMG-{} stopped at relative residual {:.2e}; "
+                      "solving directly".format(accel.upper(), rel))
+        self.ml = None  # the next tangent gets a fresh hierarchy
+        return direct(A, b, self.ordering)
+
+
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                   symmetric=True):
-    """A solver ``(A, b) -> x`` for ``fem.solve``.
+    """A solver ``(A, b) -> x`` for ``fem.solve`` and Newton's method.
 
-    ``"direct"``: :func:`direct` (ordering ``rcm+mmd`` in 2-D, ``colamd``
-    in 3-D);
-    ``"amg"``: CG (GMRES if not ``symmetric``, e.g. PPG) preconditioned by
-    pyamg smoothed aggregation with rigid body modes (needs ``doflocs`` of
-    the condensed system); if CG fails (indefinite tangent), GMRES with the
-    same hierarchy, then the direct solve, with a warning;
+    ``"direct"``: :func:`direct` (PARDISO if installed, else SuperLU with
+    ordering ``rcm+mmd`` in 2-D, ``colamd`` in 3-D);
+    ``"amg"``: :class:`AMGSolver` (needs ``doflocs`` of the condensed
+    system for the rigid-body modes; keeps its hierarchy across calls);
     ``"auto"``: direct up to ``direct_limit`` unknowns (default
     :data:`DIRECT_LIMIT` of the dimension of ``doflocs``), else AMG.
     """
     dim = 2 if doflocs is None else doflocs.shape[0]
-    ordering = "colamd" if dim == 3 else "rcm+mmd"
+    ordering = ("pardiso" if pardiso_available()
+                else "colamd" if dim == 3 else "rcm+mmd")
     if direct_limit is None:
         direct_limit = DIRECT_LIMIT.get(dim, 60_000)
+    if kind not in ("auto", "direct", "amg"):
+        raise ValueError("unknown linear solver {!r}: use 'auto', 'direct' "
+                         "or 'amg'".format(kind))
+    amg = AMGSolver(doflocs, tol=tol, symmetric=symmetric,
+                    direct_limit=4 * direct_limit, ordering=ordering)
 
     def solve(A, b, **kwargs):
         k = kind
@@ -105,27 +230,8 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                 else "amg"
         if k == "direct":
             return direct(A, b, ordering)
-        if k == "amg":
-            import pyamg
-            B = rigid_body_modes(doflocs) if doflocs is not None else None
-            ml = pyamg.smoothed_aggregation_solver(
-                A.tocsr(), B=B,
-                symmetry="hermitian" if symmetric else "nonsymmetric")
-            bn = max(np.linalg.norm(b), 1e-300)
-            for accel in (("cg", "gmres") if symmetric else ("gmres",)):
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore")  # CG's indefinite note
-                    x = ml.solve(b, tol=tol, accel=accel,
-                                 maxiter=min(500, A.shape[0]))
-                rel = np.linalg.norm(b - A @ x) / bn  # the true residual
-                if rel <= 1e3 * tol:  # preconditioned vs true residual
-                    return x
-            # an indefinite tangent (e.g. past a limit point) or a hard
-            # system: the direct solve is the safe answer
-            warnings.warn("AMG-{} stopped at relative residual {:.2e}; "
-                          "solving directly".format(accel.upper(), rel))
-            return direct(A, b, ordering)
-        raise ValueError("unknown linear solver {!r}".format(kind))
+        return amg(A, b)
+    solve.amg = amg
     return solve
 
 
@@ -196,7 +302,10 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         below ``1e-10 |u|`` (the round-off floor of ill-conditioned, e.g.
         nearly incompressible, problems).
     solver
-        Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``.
+        Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``
+        (:func:`linear_solver` on the free dofs), or a callable ``(A, b)
+        -> x`` for the condensed systems, e.g. a :func:`linear_solver`
+        built once and shared by several calls.
     predictor
         Start each load step from the linear extrapolation of the last two
         converged states (secant predictor) instead of the last one; a
@@ -216,7 +325,8 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     f_ext = np.zeros(N) if f_ext is None else _vector(f_ext, N, "f_ext")
     u_D = np.zeros(N) if u_D is None else _vector(u_D, N, "u_D")
     u = np.zeros(N) if u0 is None else _vector(u0, N, "u0").copy()
-    lin = _condensed_solver(solver, basis, I)
+    lin = solver if callable(solver) else _condensed_solver(solver, basis, I)
+    stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam, dlam = 0.0, 1.0 / steps
     prev = None  # (load, u) of the converged step before the last
     history = []
@@ -226,9 +336,11 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         start = u
         if predictor and prev is not None:
             start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
+        n_krylov = len(stats["iterations"])
         ok, uk, info = _newton_step(model, start, target, f_ext, Dd, u_D, I,
                                     lin, tol, maxiter)
-        info.update(load=target, seconds=time.perf_counter() - t0)
+        info.update(load=target, seconds=time.perf_counter() - t0,
+                    krylov=stats["iterations"][n_krylov:])
         if verbose:
             print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
                   "min J {:.3g}".format(
