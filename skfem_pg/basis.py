@@ -268,96 +268,98 @@ class FamilyBasis(AbstractBasis):
         self._check_families()
         self.timings["families"] = time.perf_counter() - t0
 
-        t0 = time.perf_counter()
-        G = GRADIENTS[shape](x, V, families, n=weight_exponent)
-        self.timings["gradients"] = time.perf_counter() - t0
-        if bond:
-            t0 = time.perf_counter()
-            G = bond_correction(G, x, families)
-            self.timings["bond"] = time.perf_counter() - t0
-
-        mem, mask = families.padded()
-        Vm = V[mem] * mask
-        if ppg:
-            self.dx = petrov.quadrature_weights(V, families)
-            Gt = np.zeros_like(G)  # test derivatives at the masters
-            Gt[:, 0] = G[:, 0]
-            if test_shape == "LME":
-                g, ok = lme_master_gradients(x, families, mu=lme_mu)
-                Gt[ok, 0] = g[ok]
-            elif test_shape in LS_TEST_GRADIENTS:
-                Gt[:, 0] = LS_TEST_GRADIENTS[test_shape](
-                    x, V, families, n=weight_exponent)
-            elif test_shape == "WTE1":
-                Gt[:, 0] = GRADIENTS["WTE1"](x, V, families,
-                                             n=weight_exponent)[:, 0]
-            dx_t = np.zeros_like(Vm)
-            dx_t[:, 0] = V[families.masters]
-        else:
-            self.dx = pbg_weights(V, families)
         self.vc_report = None
         self.vc_boundary = vc_boundary
-        if vc is not None:
+        unpadded = (not ppg and shape in ("MTE1", "WTE1")
+                    and vc in (None, "V3", "V5") and vc_exclude is None
+                    and vc_boundary in ("min-norm", "p"))
+        self._G = self._G_groups = None
+        if unpadded:  # the default: each size group without padding
+            self._unpadded_pipeline(vc_solver, area_vectors, vc_tolerance)
+        else:
             t0 = time.perf_counter()
-            if area_vectors is None:
-                area_vectors = particles.area_vectors()
-            area_vectors = np.asarray(area_vectors, dtype=float)
-            if area_vectors.shape != x.shape:
-                raise ValueError("area_vectors must have shape {}, got {}"
-                                 .format(x.shape, area_vectors.shape))
-            # VC2 of PPG1 corrects test functions only: V1 functions
-            # (the thesis' VC2PPG V1s U2); of PBG, V4 (keeps the trial's
-            # quadratic consistency)
-            surface = (particles.surface_area_vectors()
-                       if particles.mesh is not None else None)
-            phi = correction_functions("V1" if vc == "VC2" and ppg else vc,
-                                       x, V, families, n=weight_exponent)
-            if vc == "VC2" and ppg:
-                warnings.warn(
-                    "VC2 PPG1 (VC2PPG V1 U2) passes the quadratic patch "
-                    "test but is unstable here: its free tangent has "
-                    "eigenvalues with negative real part (40 on a regular "
-                    "20x10 block, 214 distorted) and it does not converge "
-                    "on a manufactured solution; prefer PBG's VC2")
-                Gt, self.vc_report = vc2_correction(
-                    Gt, dx_t, x, V, families, area_vectors,
-                    particles.area_moments(), phi, exclude=vc_exclude,
-                    boundary=vc_boundary, method="PPG1", surface=surface)
-            elif vc == "VC2":
-                G, self.vc_report = vc2_correction(
-                    G, self.dx, x, V, families, area_vectors,
-                    particles.area_moments(), phi, exclude=vc_exclude,
-                    boundary=vc_boundary, surface=surface)
-            elif method == "PPG2":  # (5.17), its own sparse system
-                warnings.warn(
-                    "VC PPG2 passes the patch test but is unstable here: "
-                    "its tangent has eigenvalues with negative real part "
-                    "(e.g. 4 on a regular 20x10 block) and it does not "
-                    "converge on a manufactured solution; prefer PPG1")
-                Gm, self.vc_report = petrov.ppg2_vc_correction(
-                    Gt[:, 0], V, families, area_vectors, phi,
-                    exclude=vc_exclude)
-                Gt[:, 0] = Gm
-            elif ppg:  # (5.16) is (5.18) with the master weights only
-                Gt, self.vc_report = vc_correction(
-                    Gt, dx_t, x, V, families, area_vectors, phi,
-                    variant=vc, solver=vc_solver, exclude=vc_exclude,
-                    boundary=vc_boundary, surface=surface)
+            G = GRADIENTS[shape](x, V, families, n=weight_exponent)
+            self.timings["gradients"] = time.perf_counter() - t0
+            if bond:
+                t0 = time.perf_counter()
+                G = bond_correction(G, x, families)
+                self.timings["bond"] = time.perf_counter() - t0
+
+            mem, mask = families.padded()
+            Vm = V[mem] * mask
+            if ppg:
+                self.dx = petrov.quadrature_weights(V, families)
+                Gt = np.zeros_like(G)  # test derivatives at the masters
+                Gt[:, 0] = G[:, 0]
+                if test_shape == "LME":
+                    g, ok = lme_master_gradients(x, families, mu=lme_mu)
+                    Gt[ok, 0] = g[ok]
+                elif test_shape in LS_TEST_GRADIENTS:
+                    Gt[:, 0] = LS_TEST_GRADIENTS[test_shape](
+                        x, V, families, n=weight_exponent)
+                elif test_shape == "WTE1":
+                    Gt[:, 0] = GRADIENTS["WTE1"](x, V, families,
+                                                 n=weight_exponent)[:, 0]
+                dx_t = np.zeros_like(Vm)
+                dx_t[:, 0] = V[families.masters]
             else:
-                G, self.vc_report = vc_correction(
-                    G, self.dx, x, V, families, area_vectors, phi,
-                    variant=vc, solver=vc_solver, exclude=vc_exclude,
-                    boundary=vc_boundary, surface=surface)
-            self.timings["vc"] = time.perf_counter() - t0
-        what = ("{} {}".format(method, shape) if vc is None
-                else "VC {} ({}{})".format(
-                    vc, method, "" if vc_boundary == "min-norm"
-                    else ", boundary " + vc_boundary))
-        check_correction(Gt if ppg else G, x, families, self.vc_report,
-                         vc_tolerance, what=what)
-        if ppg:  # the trial derivatives too
-            check_correction(G, x, families, None, what=shape + " trial")
-        self.G = G
+                self.dx = pbg_weights(V, families)
+            if vc is not None:
+                t0 = time.perf_counter()
+                area_vectors = self._area_vectors(area_vectors)
+                # VC2 of PPG1 corrects test functions only: V1 functions
+                # (the thesis' VC2PPG V1s U2); of PBG, V4 (keeps the trial's
+                # quadratic consistency)
+                surface = (particles.surface_area_vectors()
+                           if particles.mesh is not None else None)
+                phi = correction_functions("V1" if vc == "VC2" and ppg else vc,
+                                           x, V, families, n=weight_exponent)
+                if vc == "VC2" and ppg:
+                    warnings.warn(
+                        "VC2 PPG1 (VC2PPG V1 U2) passes the quadratic patch "
+                        "test but is unstable here: its free tangent has "
+                        "eigenvalues with negative real part (40 on a regular "
+                        "20x10 block, 214 distorted) and it does not converge "
+                        "on a manufactured solution; prefer PBG's VC2")
+                    Gt, self.vc_report = vc2_correction(
+                        Gt, dx_t, x, V, families, area_vectors,
+                        particles.area_moments(), phi, exclude=vc_exclude,
+                        boundary=vc_boundary, method="PPG1", surface=surface)
+                elif vc == "VC2":
+                    G, self.vc_report = vc2_correction(
+                        G, self.dx, x, V, families, area_vectors,
+                        particles.area_moments(), phi, exclude=vc_exclude,
+                        boundary=vc_boundary, surface=surface)
+                elif method == "PPG2":  # (5.17), its own sparse system
+                    warnings.warn(
+                        "VC PPG2 passes the patch test but is unstable here: "
+                        "its tangent has eigenvalues with negative real part "
+                        "(e.g. 4 on a regular 20x10 block) and it does not "
+                        "converge on a manufactured solution; prefer PPG1")
+                    Gm, self.vc_report = petrov.ppg2_vc_correction(
+                        Gt[:, 0], V, families, area_vectors, phi,
+                        exclude=vc_exclude)
+                    Gt[:, 0] = Gm
+                elif ppg:  # (5.16) is (5.18) with the master weights only
+                    Gt, self.vc_report = vc_correction(
+                        Gt, dx_t, x, V, families, area_vectors, phi,
+                        variant=vc, solver=vc_solver, exclude=vc_exclude,
+                        boundary=vc_boundary, surface=surface)
+                else:
+                    G, self.vc_report = vc_correction(
+                        G, self.dx, x, V, families, area_vectors, phi,
+                        variant=vc, solver=vc_solver, exclude=vc_exclude,
+                        boundary=vc_boundary, surface=surface)
+                self.timings["vc"] = time.perf_counter() - t0
+            what = ("{} {}".format(method, shape) if vc is None
+                    else "VC {} ({}{})".format(
+                        vc, method, "" if vc_boundary == "min-norm"
+                        else ", boundary " + vc_boundary))
+            check_correction(Gt if ppg else G, x, families, self.vc_report,
+                             vc_tolerance, what=what)
+            if ppg:  # the trial derivatives too
+                check_correction(G, x, families, None, what=shape + " trial")
+            self.G = G
         self.test = None
         self.area_correction = (None if self.vc_report is None
                                 else self.vc_report.area_correction)
@@ -377,6 +379,7 @@ class FamilyBasis(AbstractBasis):
             self.dofs = None
         self._N = nc * particles.n
         self.doflocs = np.repeat(x, nc, axis=1)
+        mem = families.padded()[0]
         nf, m = mem.shape
         self.nelems = nf
         self.Nbfun = nc * m
@@ -387,7 +390,6 @@ class FamilyBasis(AbstractBasis):
         self.W = np.ones(m)
         self._basis = None
         self._pattern = None
-        self._groups_cache = None
         self.trial = None  # set on a PPG test basis: its trial basis
         if ppg:
             self.test = copy.copy(self)
@@ -418,6 +420,57 @@ class FamilyBasis(AbstractBasis):
         return name_of(self)
 
     # ------------------------------------------------------------------
+    def _area_vectors(self, area_vectors):
+        x = self.particles.x
+        if area_vectors is None:
+            area_vectors = self.particles.area_vectors()
+        area_vectors = np.asarray(area_vectors, dtype=float)
+        if area_vectors.shape != x.shape:
+            raise ValueError("area_vectors must have shape {}, got {}"
+                             .format(x.shape, area_vectors.shape))
+        return area_vectors
+
+    def _unpadded_pipeline(self, vc_solver, area_vectors, vc_tolerance):
+        """PBG with MTE1/WTE1 derivatives, bond and V3/V5 correction, one
+        size group at a time (:mod:`skfem_pg.layout`): work and storage
+        :math:`\\propto \\sum_k m_k^2` instead of :math:`n_f m_{max}^2`;
+        the kernels are the padded ones, run on each group's own
+        families."""
+        p, fam = self.particles, self.families
+        x, V, n = p.x, p.volumes, self.weight_exponent
+        L = fam.groups()
+        subs = [L.subset(g) for g in L]
+        t0 = time.perf_counter()
+        Gs = [GRADIENTS[self.shape](x, V, f, n=n) for f in subs]
+        self.timings["gradients"] = time.perf_counter() - t0
+        if self.bond:
+            t0 = time.perf_counter()
+            Gs = [bond_correction(G, x, f) for G, f in zip(Gs, subs)]
+            self.timings["bond"] = time.perf_counter() - t0
+        dxs = [pbg_weights(V, f) for f in subs]
+        flat = np.empty(L.n_points)
+        for g, d in zip(L, dxs):
+            flat[g.flat] = d
+        self.dx = L.flat_to_padded(flat)
+        if self.vc is not None:
+            t0 = time.perf_counter()
+            area = self._area_vectors(area_vectors)
+            phis = [correction_functions(self.vc, x, V, f, n=n)
+                    for f in subs]
+            Gs, self.vc_report = vc_correction(
+                Gs, dxs, x, V, subs, area, phis, variant=self.vc,
+                solver=vc_solver, boundary=self.vc_boundary,
+                surface=(p.surface_area_vectors() if p.mesh is not None
+                         else None), index=[g.families for g in L])
+            self.timings["vc"] = time.perf_counter() - t0
+        what = ("PBG {}".format(self.shape) if self.vc is None
+                else "VC {} (PBG{})".format(
+                    self.vc, "" if self.vc_boundary == "min-norm"
+                    else ", boundary " + self.vc_boundary))
+        check_correction(Gs, x, subs, self.vc_report, vc_tolerance,
+                         what=what)
+        self._G_groups = Gs
+
     def _check_families(self):
         p, fam = self.particles, self.families
         if fam.n_particles != p.n:
@@ -479,24 +532,40 @@ class FamilyBasis(AbstractBasis):
         unpadded layout of the hot paths."""
         return self.families.groups()
 
+    @property
+    def G(self):
+        """``(nf, m, m, d)`` derivatives :math:`G^{kji}`, padded to the
+        largest family (zero in padded slots).  Bases built without padding
+        (the default PBG MTE1/WTE1 pipeline) assemble it on first access
+        and keep it."""
+        if self._G is None:
+            L, Gs = self.layout, self._G_groups
+            d = Gs[0].shape[-1]
+            G = np.zeros((L.n_families, L.m_max, L.m_max, d))
+            for g, Gg in zip(L, Gs):
+                G[g.families, :g.m, :g.m] = Gg
+            self._G = G
+        return self._G
+
+    @G.setter
+    def G(self, value):
+        self._G, self._G_groups = value, None
+
     def grouped_gradients(self):
-        """``G`` without padding: per size group ``(nf_b, m, m, d)``
-        (cached; ``G`` is not to be modified after construction)."""
-        if self._groups_cache is None or self._groups_cache[0] is not self.G:
-            L = self.layout
-            self._groups_cache = (self.G, [
-                np.ascontiguousarray(self.G[g.families, :g.m, :g.m])
-                for g in L], [L.take(self.dx, g) for g in L])
-        return self._groups_cache[1]
+        """``G`` without padding: per size group ``(nf_b, m, m, d)``."""
+        if self._G_groups is None:
+            self._G_groups = [
+                np.ascontiguousarray(self._G[g.families, :g.m, :g.m])
+                for g in self.layout]
+        return self._G_groups
+
+    def grouped_weights(self):
+        """``dx`` without padding: per size group ``(nf_b, m)``."""
+        return [self.layout.take(self.dx, g) for g in self.layout]
 
     def flat_weights(self):
         """``dx`` in the flat layout, ``(1, N_q)``."""
         return self.layout.padded_to_flat(self.dx)[None]
-
-    def grouped_weights(self):
-        """``dx`` without padding: per size group ``(nf_b, m)``."""
-        self.grouped_gradients()
-        return self._groups_cache[2]
 
     @kernel
     def interpolate(self, w, flat=False):

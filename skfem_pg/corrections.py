@@ -118,27 +118,30 @@ class VCReport:
                     self.residual_before, self.residual_after))
 
 
-def constraint_matrix(phi, B, fam, n_particles):
+def constraint_matrix(phi, B, fam, n_particles, index=None, nf=None):
     r"""Sparse :math:`\partial r / \partial \alpha`: block ``(i, k)`` is
     :math:`\varphi^{ki} B^k`, :math:`B^k = \sum_j w_{kj} Q^{kj}`; shape
     ``(d·np, d·nf)``.  Matrix-valued correction functions (V2,
     ``phi`` of shape ``(nf, m, d, d)``) give blocks :math:`\varphi^{ki}
-    B^k`."""
+    B^k`.  The families of ``fam`` (``B`` of shape ``(len(fam), d, d)``)
+    are block columns ``index`` of ``nf`` (default: all of them)."""
     mem, mask = fam.padded()
-    nf, m = mem.shape
+    nfl, m = mem.shape
     d = B.shape[-1]
     a = np.arange(d)
-    k = np.broadcast_to(np.arange(nf)[:, None], (nf, m))[mask]
+    kl = np.broadcast_to(np.arange(nfl)[:, None], (nfl, m))[mask]
+    k = kl if index is None else index[kl]
     i = mem[mask]
     if phi.ndim == 4:
-        vals = phi[mask] @ B[k]
+        vals = phi[mask] @ B[kl]
     else:
-        vals = phi[mask][:, None, None] * B[k]  # (nnzb, d, d)
+        vals = phi[mask][:, None, None] * B[kl]  # (nnzb, d, d)
     rows = d * i[:, None, None] + a[None, :, None]
     cols = d * k[:, None, None] + a[None, None, :]
     rows, cols = np.broadcast_arrays(rows, cols)
     return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())),
-                         shape=(d * n_particles, d * nf))
+                         shape=(d * n_particles,
+                                d * (nfl if nf is None else nf)))
 
 
 def linear_fields(x, active):
@@ -236,17 +239,19 @@ class _AMGSolve:
 AMG_VC_LIMIT_3D = 15000
 
 
-def scalar_constraint_matrix(phi, fam, n_particles):
+def scalar_constraint_matrix(phi, fam, n_particles, index=None, nf=None):
     r"""Sparse :math:`\Phi^T` with entries :math:`\varphi^{ki}` (row ``i``,
-    column ``k``), shape ``(np, nf)``."""
+    column ``k``), shape ``(np, nf)``; the families of ``fam`` are columns
+    ``index`` (default ``0..len(fam)-1``) of ``nf``."""
     mem, mask = fam.padded()
-    k = np.broadcast_to(np.arange(len(fam))[:, None], mem.shape)[mask]
+    index = np.arange(len(fam)) if index is None else index
+    k = np.broadcast_to(index[:, None], mem.shape)[mask]
     return sp.csr_matrix((phi[mask], (mem[mask], k)),
-                         shape=(n_particles, len(fam)))
+                         shape=(n_particles, len(fam) if nf is None else nf))
 
 
-def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True,
-                     iterative=False):
+def _solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
+                     min_norm=True, iterative=False):
     r"""Minimum-norm solution of the consistent, singular, square system
     ``A α = b``, :math:`A_{ik} = \varphi^{ki} B^k`, by one *scalar* sparse
     LU (with ``min_norm=False``: the pinned solution itself, the thesis'
@@ -268,10 +273,10 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True,
     converge; the refinement steps and the projection are the same.
     """
     d, n = x.shape
-    nf = len(fam)
-    PhiT = scalar_constraint_matrix(phi, fam, n).tocsr()
+    nf = len(masters)
+    PhiT = PhiT.tocsr()
     family_of = np.full(n, -1)
-    family_of[fam.masters] = np.arange(nf)
+    family_of[masters] = np.arange(nf)
     anchors = anchor_particles(x, active)
     fix = family_of[anchors]
     rows = np.setdiff1d(np.nonzero(active)[0], anchors)
@@ -329,13 +334,18 @@ def _solve_pinned_lu(phi, B, b, x, active, fam, refine=2, min_norm=True,
 
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                   solver="auto", tol=1e-14, maxiter=None, exclude=None,
-                  boundary="min-norm", surface=None):
+                  boundary="min-norm", surface=None, index=None):
     r"""Correct ``G`` so the PBG integration constraint holds.
 
     Parameters
     ----------
     G
-        ``(nf, m, m, d)`` derivatives (bond corrected for V5).
+        ``(nf, m, m, d)`` derivatives (bond corrected for V5).  Unpadded:
+        ``G``, ``dx``, ``fam`` and ``phi`` may instead be lists with one
+        entry per size group (:mod:`skfem_pg.layout`; ``fam`` the groups'
+        :meth:`~skfem_pg.layout.SizeGroups.subset` families) and ``index``
+        the groups' family indices; the corrected ``G`` is then a list
+        too.
     dx
         ``(nf, m)`` PBG weights :math:`w_{kj}`.
     x, volumes
@@ -387,6 +397,9 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         the surface particles on the interface's edge are fixed fully, as
         under ``s`` (:func:`~skfem_pg.vc_boundary.interface_edge`).
 
+    index
+        With list arguments: per group its family indices.
+
     Returns
     -------
     G_corrected, VCReport
@@ -408,19 +421,48 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         raise ValueError("boundary variant 'p' pins the d + d² linear "
                          "modes of V3/V5; {} has others: use 's' or 'sn'"
                          .format(variant))
-    mem, mask = fam.padded()
+    grouped = isinstance(G, (list, tuple))
+    if grouped:  # one part per size group: (G, dx, fam, phi, index)
+        nf = sum(len(f) for f in fam)
+        parts = list(zip(G, dx, fam, phi, index))
+    else:
+        nf = len(fam)
+        parts = [(G, dx, fam, phi, None)]
     d, n = x.shape
+    masters = np.empty(nf, dtype=np.int64)
+    for _, _, f, _, idx in parts:
+        masters[slice(None) if idx is None else idx] = f.masters
     active = volumes > 0
     h = np.mean(volumes[active]) ** (1.0 / d)
     area_scale = h ** (d - 1)
     t0 = time.perf_counter()
-    if variant == "V5":
-        Q = bond_projectors(x, fam)
-    else:
-        Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
-    nf, m = mem.shape
-    B = (dx[:, None, :] @ np.reshape(Q, (nf, m, d * d))).reshape(nf, d, d)
-    r0 = constraint_residual(G, dx, fam, area)
+    Qs, B = [], np.empty((nf, d, d))
+    for Gp, dxp, f, _, idx in parts:
+        mem = f.padded()[0]
+        if variant == "V5":
+            Q = bond_projectors(x, f)
+        else:
+            Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
+        nfp, m = mem.shape
+        B[slice(None) if idx is None else idx] = (
+            dxp[:, None, :] @ np.reshape(Q, (nfp, m, d * d))).reshape(
+                nfp, d, d)
+        Qs.append(Q)
+
+    def residual(Gl):
+        return sum(constraint_residual(Gp, p[1], p[2], 0 * area)
+                   for Gp, p in zip(Gl, parts)) - area.T
+
+    def matrix(scalar=False):
+        out = 0
+        for _, _, f, ph, idx in parts:
+            Bp = B if idx is None else B[idx]
+            out = out + (scalar_constraint_matrix(ph, f, n, idx, nf)
+                         if scalar else
+                         constraint_matrix(ph, Bp, f, n, idx, nf))
+        return out.tocsr()
+
+    r0 = residual([p[0] for p in parts])
     b = -r0.ravel()
     # the part of b outside range(A) (e.g. volumes that do not add up to
     # the enclosed volume) cannot be corrected: least squares drops it
@@ -449,17 +491,16 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     unknowns = d * nf
 
     def lsqr():  # the full block system, only built when needed
-        A = constraint_matrix(phi, B, fam, n)
+        A = matrix()
         rows = np.repeat(keep, d)
         return _solve_lsqr(A[rows], b[rows], tol, maxiter or 20 * unknowns)
 
     if boundary in ("s", "sn"):
         R, T = vc_boundary.reduction(
-            fam.masters, area if surface is None else surface, boundary, n,
+            masters, area if surface is None else surface, boundary, n,
             active, full=vc_boundary.interface_edge(area, surface))
         try:
-            alpha = vc_boundary.solve_reduced(
-                constraint_matrix(phi, B, fam, n), b, R, T)
+            alpha = vc_boundary.solve_reduced(matrix(), b, R, T)
         except RuntimeError as err:
             raise RuntimeError("VC {} with boundary variant {!r}: {}".format(
                 variant, boundary, err)) from None
@@ -471,8 +512,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     elif solver in ("direct", "amg"):
         try:
             alpha, its, used = _solve_pinned_lu(
-                phi, B, b, x, active, fam, min_norm=boundary == "min-norm",
-                iterative=solver == "amg")
+                matrix(scalar=True), masters, B, b, x, active,
+                min_norm=boundary == "min-norm", iterative=solver == "amg")
             if used != solver:
                 notes.append("AMG-GMRES did not converge; solved by LU")
                 solver = used
@@ -485,13 +526,19 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         raise ValueError("unknown VC solver {!r}: use 'direct', 'amg', "
                          "'lsqr' or 'auto'".format(solver))
     alpha = alpha.reshape(-1, d)
-    if phi.ndim == 4:  # V2: C^{kji} = phi^{ki} alpha^k for every member j
-        Ha = (phi @ alpha[:, None, :, None])[..., 0]  # (nf, m_i, d)
-        Gc = G + mask[:, :, None, None] * Ha[:, None, :, :]
-    else:
-        Qa = (Q @ alpha[:, None, :, None])[..., 0] * mask[..., None]
-        Gc = G + phi[:, None, :, None] * Qa[:, :, None, :]  # 0 if padded
-    r1 = constraint_residual(Gc, dx, fam, area)
+    Gc = []
+    for (Gp, _, f, ph, idx), Q in zip(parts, Qs):
+        mask = f.padded()[1]
+        al = alpha if idx is None else alpha[idx]
+        if ph.ndim == 4:  # V2: C^{kji} = phi^{ki} alpha^k, every member j
+            Ha = (ph @ al[:, None, :, None])[..., 0]  # (nf, m_i, d)
+            Gc.append(Gp + mask[:, :, None, None] * Ha[:, None, :, :])
+        else:
+            Qa = (Q @ al[:, None, :, None])[..., 0] * mask[..., None]
+            Gc.append(Gp + ph[:, None, :, None] * Qa[:, :, None, :])
+    r1 = residual(Gc)
+    if not grouped:
+        Gc = Gc[0]
     if boundary in ("s", "sn"):  # imposed: R r = 0; the rest moves A^i
         imposed = (R @ r0.ravel(), R @ r1.ravel())
         area_correction = r1.T.copy()
@@ -540,7 +587,8 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
 
     Raises :class:`~skfem_pg.errors.CorrectionError`, naming the worst
     particles, when the derivatives ``G`` (``(nf, m, m, d)`` or the
-    master derivatives ``(nf, m, d)``) are not finite, when
+    master derivatives ``(nf, m, d)``; or lists of them per size group,
+    ``fam`` then the groups' families) are not finite, when
     :math:`\max |G^{kji}|\,h_k` exceeds :data:`GRADIENT_LIMIT`, or when the
     constraint residual left by the correction (``report``) is above
     ``tolerance`` (relative to :math:`h^{d-1}`; ``report=None``: no
@@ -549,9 +597,14 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
     corrections).
     """
     from .errors import CorrectionError, describe_particle
-    masters = fam.masters
-    axes = tuple(range(1, G.ndim))
-    bad = ~np.all(np.isfinite(G), axis=axes)
+    if isinstance(G, (list, tuple)):  # per size group, fam the subsets
+        Gl, fl = G, fam
+    else:
+        Gl, fl = [G], [fam]
+    masters = np.concatenate([f.masters for f in fl])
+    sizes = np.concatenate([f.sizes for f in fl])
+    bad = np.concatenate([~np.all(np.isfinite(g), axis=tuple(
+        range(1, g.ndim))) for g in Gl])
     if np.any(bad):
         k = np.nonzero(bad)[0]
         raise CorrectionError(
@@ -560,8 +613,9 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
             "Use larger families (a larger horizon or more neighbours)."
             .format(what, len(k), describe_particle(masters[k[0]],
                                                     x[:, masters[k[0]]]),
-                    fam.sizes[k[0]]))
-    gh = np.abs(G).max(axis=axes) * family_radii(x, fam)
+                    sizes[k[0]]))
+    gh = np.concatenate([np.abs(g).max(axis=tuple(range(1, g.ndim)))
+                         * family_radii(x, f) for g, f in zip(Gl, fl)])
     if gh.max() > GRADIENT_LIMIT:
         worst = np.argsort(gh)[::-1][:3]
         why = ("their moment matrices are near-singular" if report is None

@@ -67,6 +67,7 @@ class SizeGroups:
             flat = offsets[fam][:, None] + np.arange(m)
             self.groups.append(Group(fam, m, flat, families.members[flat]))
         self.n_families = len(families)
+        self.n_particles = families.n_particles
         self.n_points = int(offsets[-1])
         self.m_max = int(sizes.max())
         self.sizes = sizes
@@ -76,6 +77,15 @@ class SizeGroups:
 
     def __len__(self):
         return len(self.groups)
+
+    def subset(self, group):
+        """The families of ``group`` as a
+        :class:`~skfem_pg.families.Families` of their own (no padding: the
+        batched kernels run on it unchanged)."""
+        from .families import Families
+        nf, m = group.members.shape
+        return Families(np.arange(nf + 1) * m, group.members.ravel(),
+                        self.n_particles)
 
     def is_flat(self, shape):
         """Whether trailing quadrature axes ``shape`` are the flat layout
