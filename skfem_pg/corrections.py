@@ -198,10 +198,13 @@ class _PermutedLU:
 
 class _AMGSolve:
     """GMRES preconditioned by smoothed-aggregation AMG (pyamg, the
-    nonsymmetric variant) for the pinned scalar VC matrix: its cost grows
-    linearly with the particles, where the sparse LU's fill does not
-    (gmsh tetrahedra, 20.8k particles: setup 0.2 s + 1.1 s per right-hand
-    side against 9.5 s for COLAMD's LU).  ``solve`` takes one or several
+    nonsymmetric variant, energy-minimising prolongators, coarsest level of
+    up to 5000 unknowns by SuperLU) for the pinned scalar VC matrix: its
+    cost grows about linearly with the particles, where the sparse LU's
+    fill does not.  On gmsh tetrahedra (benchmarks/README.md), 7
+    right-hand sides: 20.8k particles 274 iterations; 51.9k 1.3 s setup +
+    10.6 s (48 iterations each) against 24 s with the default SA
+    settings and 89 s for COLAMD's LU.  ``solve`` takes one or several
     right-hand-side columns; a column that does not reach ``tol`` in
     ``maxiter`` iterations raises ``RuntimeError``."""
 
@@ -209,7 +212,8 @@ class _AMGSolve:
         import pyamg
         self.A = A.tocsr()
         self.ml = pyamg.smoothed_aggregation_solver(
-            self.A, symmetry="nonsymmetric", max_coarse=500)
+            self.A, symmetry="nonsymmetric", smooth="energy",
+            max_coarse=5000, coarse_solver="splu")
         self.tol, self.maxiter = tol, maxiter
         self.iterations = 0
 
