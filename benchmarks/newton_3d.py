@@ -22,7 +22,6 @@ import skfem_pg as pg
 from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg.scenes import Scene
-from skfem_pg.solvers import linear_solver
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")
@@ -71,8 +70,7 @@ def iterations(sc, scheme, solver, load, steps, **kw):
     model.material = material
     timed = Timed(model, ("state", "internal_force", "tangent"))
     I = np.setdiff1d(np.arange(basis.N), D)
-    lin = linear_solver(solver, basis.doflocs[:, I],
-                        symmetric=not getattr(basis, "is_petrov", False))
+    lin = pg.solvers._condensed_solver(solver, basis, I)
     t_lin = [0.0]
 
     def solve(A, b):

@@ -63,7 +63,8 @@ def one(size):
         K, r[name + "_assemble"] = clock(pg.assemble, form, B)
         r[name + "_nnz"] = int(K.nnz)
         I = np.setdiff1d(np.arange(B.N), D)
-        lin = linear_solver("amg", B.doflocs[:, I])
+        lin = linear_solver("amg", B.doflocs[:, I], candidates=(
+            pg.solvers.PG_CANDIDATES if name == "pg" else 0))
         x, r[name + "_solve"] = clock(lin, K[I][:, I].tocsr(),
                                       loads[name][I])
         r[name + "_cg"] = lin.amg.stats["iterations"][-1]

@@ -145,7 +145,8 @@ def renumber(mesh):
     perm = reverse_cuthill_mckee(A, symmetric_mode=True)
     inv = np.empty(n, dtype=np.int64)
     inv[perm] = np.arange(n)
-    new = type(mesh)(mesh.p[:, perm], inv[t])
+    new = type(mesh)(np.ascontiguousarray(mesh.p[:, perm]),
+                     np.ascontiguousarray(inv[t]))
     if mesh.boundaries:
         # facets by their sorted vertex tuples
         keys = np.sort(new.facets, axis=0)

@@ -125,20 +125,28 @@ class AMGSolver:
       dofs come in whole nodes; prolongator smoothing ``smooth`` (default
       ``"energy"``: on 3-D Cook PG tangents 50 CG iterations against 65
       for Jacobi smoothing, benchmarks/README.md).
-    * Fallback chain, costing at most one failed Krylov attempt more than
-      the direct solve: a failed solve with a fresh hierarchy goes to the
-      direct solve (with a warning) when the system has at most
-      ``direct_limit`` unknowns; above it, to GMRES with the same
-      hierarchy (CG fails on indefinite tangents, e.g. past a limit
-      point), then to the direct solve.
+    * ``candidates`` random vectors, smoothed by 10 fine-level
+      Gauss-Seidel sweeps, join the rigid-body modes as near-null-space
+      candidates: PG tangents have many soft modes (Jacobi-scaled
+      condition number 8e4 against O1's 2e3 on a 1.2k-node cube), which
+      the rigid-body modes alone leave to CG (7.4k-node cube, linear
+      elasticity: 51 CG iterations with 6 candidates against 119 without,
+      the setup 5.8 s against 1.7 s, so it pays from the first solve on
+      and more so with a reused hierarchy).
+    * Fallback chain: CG fails on indefinite tangents (past a limit point,
+      or PG at an overshooting Newton iterate); then MINRES with the same
+      (positive) preconditioner; above ``direct_limit`` unknowns GMRES with
+      the same hierarchy; then the direct solve, with a warning.
 
     ``stats`` counts builds, solves, iterations and fallbacks.
     """
 
     def __init__(self, doflocs=None, tol=1e-10, symmetric=True,
                  smooth="energy", maxiter=500,
-                 direct_limit=4 * DIRECT_LIMIT[3], ordering="auto"):
+                 direct_limit=4 * DIRECT_LIMIT[3], ordering="auto",
+                 candidates=0):
         self.doflocs, self.tol, self.symmetric = doflocs, tol, symmetric
+        self.candidates = int(candidates)
         self.smooth, self.maxiter = smooth, maxiter
         self.direct_limit, self.ordering = direct_limit, ordering
         self.ml, self.base_its, self.stale, self.t_setup = None, None, \
@@ -153,9 +161,18 @@ class AMGSolver:
         B = rigid_body_modes(locs) if locs is not None else None
         bs = _node_blocks(locs) if locs is not None else 1
         M = A.tobsr(blocksize=(bs, bs)) if bs > 1 else A
+        kw = {}
+        if self.candidates and B is not None:
+            # PG's soft modes: random vectors smoothed by the fine-level
+            # Gauss-Seidel join the rigid-body modes
+            rng = np.random.default_rng(0)
+            B = np.hstack([B, rng.normal(size=(A.shape[0], self.candidates))])
+            kw["improve_candidates"] = [
+                ("block_gauss_seidel" if bs > 1 else "gauss_seidel",
+                 {"sweep": "symmetric", "iterations": 10}), None]
         self.ml = pyamg.smoothed_aggregation_solver(
             M, B=B, smooth=self.smooth,
-            symmetry="hermitian" if self.symmetric else "nonsymmetric")
+            symmetry="hermitian" if self.symmetric else "nonsymmetric", **kw)
         self.base_its, self.stale = None, False
         self.t_setup = time.perf_counter() - t0
         self.stats["builds"] += 1
@@ -176,6 +193,23 @@ class AMGSolver:
         # preconditioned vs true residual
         return x, len(res), rel <= 1e3 * self.tol, rel
 
+    def _minres(self, A, b):
+        its = [0]
+
+        def count(xk):
+            its[0] += 1
+        import inspect
+        key = ("rtol" if "rtol" in inspect.signature(spl.minres).parameters
+               else "tol")  # scipy < 1.12: tol
+        try:
+            x, _ = spl.minres(A, b, M=self.ml.aspreconditioner(),
+                              maxiter=min(self.maxiter, A.shape[0]),
+                              callback=count, **{key: self.tol})
+        except ValueError:  # a hierarchy built from an indefinite matrix
+            return None, its[0], False, np.inf
+        rel = np.linalg.norm(b - A @ x) / max(np.linalg.norm(b), 1e-300)
+        return x, its[0], rel <= 1e3 * self.tol, rel
+
     def __call__(self, A, b, **kwargs):
         A = A.tocsr()
         self.stats["solves"] += 1
@@ -194,7 +228,7 @@ class AMGSolver:
             x, its2, ok, rel = self._krylov(A, b, accel)
             t_it = (time.perf_counter() - t0) / max(its2, 1)
             its += its2
-        if ok and fresh:
+        if ok and (fresh or self.base_its is None):
             self.base_its = its
         elif ok:  # reused: rebuild for the next system once the extra
             # iterations cost more than a setup
@@ -203,25 +237,36 @@ class AMGSolver:
         if ok:
             return x
         self.stats["fallbacks"] += 1
+        if accel == "cg":  # an indefinite tangent (past a limit point, or
+            # PG at an overshooting Newton iterate): MINRES with the same
+            # symmetric positive preconditioner
+            x, its, ok, rel = self._minres(A, b)
+            self.stats["iterations"][-1] += its
+            if ok:
+                return x
         if A.shape[0] > self.direct_limit and accel == "cg":
             x, its, ok, rel = self._krylov(A, b, "gmres")
             self.stats["iterations"][-1] += its
             if ok:
                 return x
-        warnings.warn("AMG-{} stopped at relative residual {:.2e}; "
-                      "solving directly".format(accel.upper(), rel))
+        warnings.warn("AMG-{} failed (relative residual {:.2e}); solving "
+                      "directly".format(
+                          "CG and MINRES" if accel == "cg" else
+                          accel.upper(), rel))
         self.ml = None  # the next tangent gets a fresh hierarchy
         return direct(A, b, self.ordering)
 
 
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
-                  symmetric=True):
+                  symmetric=True, candidates=0):
     """A solver ``(A, b) -> x`` for ``fem.solve`` and Newton's method.
 
     ``"direct"``: :func:`direct` (PARDISO if installed, else SuperLU with
     ordering ``rcm+mmd`` in 2-D, ``colamd`` in 3-D);
     ``"amg"``: :class:`AMGSolver` (needs ``doflocs`` of the condensed
-    system for the rigid-body modes; keeps its hierarchy across calls);
+    system for the rigid-body modes; keeps its hierarchy across calls;
+    ``candidates`` extra near-null-space vectors, :data:`PG_CANDIDATES`
+    for family bases in Newton's method);
     ``"auto"``: direct up to ``direct_limit`` unknowns (default
     :data:`DIRECT_LIMIT` of the dimension of ``doflocs``), else AMG.
     """
@@ -234,7 +279,8 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
         raise ValueError("unknown linear solver {!r}: use 'auto', 'direct' "
                          "or 'amg'".format(kind))
     amg = AMGSolver(doflocs, tol=tol, symmetric=symmetric,
-                    direct_limit=4 * direct_limit, ordering=ordering)
+                    direct_limit=4 * direct_limit, ordering=ordering,
+                    candidates=candidates)
 
     def solve(A, b, **kwargs):
         k = kind
@@ -285,10 +331,17 @@ def _vector(v, N, what):
     return v
 
 
+#: extra smoothed random near-null-space candidates of the AMG hierarchy
+#: for family bases (:class:`AMGSolver`)
+PG_CANDIDATES = 6
+
+
 def _condensed_solver(kind, basis, I):
     locs = getattr(basis, "doflocs", None)
     return linear_solver(kind, None if locs is None else locs[:, I],
-                         symmetric=getattr(basis, "test", None) is None)
+                         symmetric=getattr(basis, "test", None) is None,
+                         candidates=PG_CANDIDATES if hasattr(basis, "layout")
+                         else 0)
 
 
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
