@@ -37,39 +37,45 @@ def clock(fn, *args, **kw):
     return out, time.perf_counter() - t0
 
 
-def amg_solve(K, f, D, doflocs):
-    """CG + pyamg smoothed aggregation with rigid body modes."""
+def amg_solve(K, f, D, doflocs, candidates=0):
+    """CG + pyamg smoothed aggregation with rigid body modes (and, for PG,
+    ``candidates`` smoothed random near-null-space vectors)."""
     I = np.setdiff1d(np.arange(K.shape[0]), D)
     x = np.zeros(K.shape[0])
-    x[I] = pg.solvers.linear_solver("amg", doflocs[:, I], tol=1e-10)(
+    x[I] = pg.solvers.linear_solver("amg", doflocs[:, I], tol=1e-10,
+                                    candidates=candidates)(
         K[I][:, I].tocsr(), f[I])
     return x
 
 
-def run(n, generic=False, pg_solve=False, amg=False):
+def run(n, generic=False, pg_solve=False, amg=False, dim=2):
+    Mesh, E = ((fem.MeshQuad, fem.ElementQuad1) if dim == 2
+               else (fem.MeshHex, fem.ElementHex1))
     mesh = pg.meshing.distort(
-        fem.MeshQuad.init_tensor(*[np.linspace(0, 1, n + 1)] * 2), 0.3,
-        seed=n)
+        Mesh.init_tensor(*[np.linspace(0, 1, n + 1)] * dim), 0.3, seed=n)
     r = {"n": n, "particles": int(mesh.nvertices)}
-    # --- scikit-fem Q1 -------------------------------------------------
-    q1, r["q1_basis"] = clock(fem.Basis, mesh,
-                              fem.ElementVector(fem.ElementQuad1()))
+    # --- scikit-fem Q1 / H1 --------------------------------------------
+    q1, r["q1_basis"] = clock(fem.Basis, mesh, fem.ElementVector(E()))
     Kq, r["q1_assemble"] = clock(FORM.assemble, q1)
+    _, r["q1_fast_first"] = clock(pg.assemble, FORM, q1)
+    Kf, r["q1_fast"] = clock(pg.assemble, FORM, q1)
+    r["fast_vs_generic_fe"] = float(abs(Kf - Kq).max() / abs(Kq).max())
     f = q1.zeros()
     f[q1.get_dofs(lambda x: np.isclose(x[0], 1)).nodal["u^2"]] = 1.0 / n
     D = q1.get_dofs(lambda x: np.isclose(x[0], 0))
-    _, r["q1_solve_default"] = clock(
-        lambda: fem.solve(*fem.condense(Kq, f, D=D)))
-    uq, r["q1_solve"] = clock(
-        lambda: fem.solve(*fem.condense(Kq, f, D=D), solver=SOLVER))
-    r["q1_nnz"] = int(Kq.nnz)
     Dflat = D.flatten()
-    if amg:
+    if dim == 2:
+        uq, r["q1_solve"] = clock(
+            lambda: fem.solve(*fem.condense(Kq, f, D=D), solver=SOLVER))
+    else:  # 3-D: AMG-CG (direct solves of PG fill beyond reach)
+        uq, r["q1_solve"] = clock(amg_solve, Kq, f, Dflat, q1.doflocs)
+    r["q1_nnz"] = int(Kq.nnz)
+    if amg and dim == 2:
         _, r["q1_solve_amg"] = clock(amg_solve, Kq, f, Dflat, q1.doflocs)
     # --- PG ------------------------------------------------------------
     t0 = time.perf_counter()
     particles, r["pg_particles"] = clock(pg.Particles.from_mesh, mesh)
-    basis = pg.FamilyBasis(particles, dim=2)
+    basis = pg.FamilyBasis(particles, dim=dim)
     r["pg_preprocess"] = time.perf_counter() - t0
     for k, v in basis.timings.items():
         r["pg_" + k] = v
@@ -81,19 +87,24 @@ def run(n, generic=False, pg_solve=False, amg=False):
         basis._basis = None
         Kg, r["pg_assemble_generic"] = clock(FORM.assemble, basis)
         r["generic_vs_fast"] = float(abs(Kg - K).max() / abs(K).max())
-    if pg_solve:
+    if pg_solve and dim == 2:
         u, r["pg_solve"] = clock(
             lambda: fem.solve(*fem.condense(K, f, D=D), solver=SOLVER))
         r["tip_pg_vs_q1"] = float(u[-1] / uq[-1])
-    if amg:
+    elif pg_solve:
+        u, r["pg_solve"] = clock(amg_solve, K, f, Dflat, basis.doflocs,
+                                 pg.solvers.PG_CANDIDATES)
+        r["tip_pg_vs_q1"] = float(u[-1] / uq[-1])
+    if amg and dim == 2:
         _, r["pg_solve_amg"] = clock(amg_solve, K, f, Dflat, basis.doflocs)
     r["ratio_asm"] = r["pg_assemble"] / r["q1_assemble"]
+    r["ratio_asm_fast"] = r["pg_assemble"] / r["q1_fast"]
     r["ratio_asm_first"] = r["pg_assemble_first"] / r["q1_assemble"]
     r["ratio_pre_q1solve"] = r["pg_preprocess"] / r["q1_solve"]
     return r
 
 
-def main(sizes, amg=False):
+def main(sizes, amg=False, dim=2):
     print(pg.threads.describe())
     rows = []
     hdr = ("{:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s} {:>8s}"
@@ -102,7 +113,8 @@ def main(sizes, amg=False):
                      "asm", "Q1asm", "Q1solve", "PGsolve", "asm/Q1",
                      "pre/Q1slv"))
     for n in sizes:
-        r = run(n, generic=n <= 100, pg_solve=True, amg=amg)
+        r = run(n, generic=n <= (100 if dim == 2 else 0), pg_solve=True,
+                amg=amg, dim=dim)
         rows.append(r)
         print("{:8d} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} {:8.2f} "
               "{:8.2f} {:8.2f} {:>8s} {:9.2f} {:9.2f}".format(
@@ -136,22 +148,45 @@ def main(sizes, amg=False):
                   r["particles"], r["pg_assemble_generic"],
                   r["pg_assemble_generic"] / r["pg_assemble"],
                   r["generic_vs_fast"]))
+    fe = "Q1" if dim == 2 else "H1"
     table = [[r["particles"], "{:.2f}".format(r["pg_preprocess"]),
               "{:.2f}".format(r["pg_vc"]), "{:.2f}".format(r["ratio_asm"]),
+              "{:.2f}".format(r["ratio_asm_fast"]),
               "{:.2f}".format(r["ratio_pre_q1solve"]),
               "{:.1f}".format(r["pg_solve"] / r["q1_solve"])
               if "pg_solve" in r else "-"] for r in rows]
+    growth = ""
+    if len(rows) > 1:
+        a, b = rows[0], rows[-1]
+        g = np.log(b["particles"] / a["particles"])
+        growth = ("\n\nGrowth exponents {:,} -> {:,} particles: PG "
+                  "preprocessing {:.2f} (VC {:.2f}), PG assembly {:.2f}, "
+                  "{} assembly (fast path) {:.2f}.".format(
+                      a["particles"], b["particles"],
+                      np.log(b["pg_preprocess"] / a["pg_preprocess"]) / g,
+                      np.log(b["pg_vc"] / a["pg_vc"]) / g,
+                      np.log(b["pg_assemble"] / a["pg_assemble"]) / g, fe,
+                      np.log(b["q1_fast"] / a["q1_fast"]) / g))
     print("updated", update_results(
-        RESULTS, "assembly_scaling",
-        "`python benchmarks/assembly_scaling.py --sizes {}`: VC PBG Unl "
-        "and Q1, linear elasticity, ±0.3h distorted quads; both direct "
-        "solves by `pg.solvers.direct`; Q1 assembled by scikit-fem's "
-        "generic path.\n\n".format(" ".join(str(n) for n in sizes))
+        RESULTS, "assembly_scaling" + ("" if dim == 2 else "_3d"),
+        "`python benchmarks/assembly_scaling.py --dim {d} --sizes {s}`: VC "
+        "PBG Unl and {fe}, linear elasticity, ±0.3h distorted {cells}; "
+        "{fe} assembled by scikit-fem's generic path and by the package's "
+        "fast path (both denominators); solves {solve} ({t}).\n\n".format(
+            d=dim, s=" ".join(str(n) for n in sizes), fe=fe,
+            cells="quads" if dim == 2 else "hexahedra",
+            solve="direct (`pg.solvers.direct`)" if dim == 2 else
+            "AMG-CG (`pg.solvers.linear_solver('amg')`, PG with "
+            "near-null-space candidates)", t=pg.threads.describe())
         + markdown_table(["particles", "PG preprocess [s]", "of which VC "
-                          "[s]", "PG asm / Q1 asm", "preprocess / Q1 "
-                          "solve", "PG solve / Q1 solve"], table)))
+                          "[s]", "PG asm / {} asm (scikit-fem)".format(fe),
+                          "PG asm / {} asm (fast path)".format(fe),
+                          "preprocess / {} solve".format(fe),
+                          "PG solve / {} solve".format(fe)], table)
+        + growth))
     os.makedirs(OUT, exist_ok=True)
-    with open(os.path.join(OUT, "assembly_scaling.json"), "w") as fh:
+    with open(os.path.join(OUT, "assembly_scaling{}.json".format(
+            "" if dim == 2 else "_3d")), "w") as fh:
         json.dump(rows, fh, indent=1)
     print("wrote " + OUT + "/assembly_scaling.json")
     return rows
@@ -159,10 +194,13 @@ def main(sizes, amg=False):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--sizes", type=int, nargs="+",
-                    default=[100, 200, 300, 400, 500])
+    ap.add_argument("--sizes", type=int, nargs="+", default=None,
+                    help="elements per side (default 100 ... 500 in 2-D, "
+                    "20 30 40 in 3-D)")
+    ap.add_argument("--dim", type=int, default=2, choices=(2, 3))
     ap.add_argument("--amg", action="store_true",
                     help="also time CG + smoothed aggregation solves")
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.sizes, a.amg)
+    main(a.sizes or ([100, 200, 300, 400, 500] if a.dim == 2
+                     else [20, 30, 40]), a.amg, a.dim)
