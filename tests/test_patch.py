@@ -61,16 +61,17 @@ def test_horizon_families_pass():
 @pytest.mark.parametrize("mesh", [square(8, 0.3, seed=6),
                                   cube(3, 0.3, seed=6, kind="tet")])
 def test_vc_solvers_give_the_same_min_norm_correction(mesh):
-    """The scalar pinned LU and LSQR (from zero: the minimum-norm
-    solution) agree, and both pass the patch test."""
+    """The scalar pinned LU, its AMG-GMRES solve and LSQR (from zero: the
+    minimum-norm solution) agree, and all pass the patch test."""
     G = {}
-    for solver in ("direct", "lsqr"):
+    for solver in ("direct", "amg", "lsqr"):
         r = linear_patch_test(mesh, TOP[mesh.dim()], vc_solver=solver)
         assert r["basis"].vc_report.solver == solver
         assert r["max_error"] <= 1e-10
         G[solver] = r["basis"].G
-    assert np.abs(G["direct"] - G["lsqr"]).max() <= \
-        1e-9 * np.abs(G["direct"]).max()
+    for solver in ("direct", "amg"):
+        assert np.abs(G[solver] - G["lsqr"]).max() <= \
+            1e-9 * np.abs(G["lsqr"]).max()
 
 
 @pytest.mark.parametrize("name", ["distorted quads", "distorted hexes"])
