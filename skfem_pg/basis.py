@@ -384,8 +384,7 @@ class FamilyBasis(AbstractBasis):
         self.nelems = nf
         self.Nbfun = nc * m
         self.tind = None
-        self._element_dofs = (nc * mem[:, :, None] + np.arange(nc)) \
-            .reshape(nf, nc * m).T.astype(np.int64)
+        self._element_dofs = None  # padded; built when asked for
         self.X = np.zeros((sdim, m))  # members play the quadrature points
         self.W = np.ones(m)
         self._basis = None
@@ -499,6 +498,14 @@ class FamilyBasis(AbstractBasis):
 
     @property
     def element_dofs(self):
+        """``(Nbfun, nf)`` dofs of the padded families (scikit-fem's
+        generic assembly; built on first use)."""
+        if self._element_dofs is None:
+            nc = 1 if self.ncomp is None else self.ncomp
+            mem = self.families.padded()[0]
+            nf, m = mem.shape
+            self._element_dofs = (nc * mem[:, :, None] + np.arange(nc)) \
+                .reshape(nf, nc * m).T.astype(np.int64)
         return self._element_dofs
 
     @property
