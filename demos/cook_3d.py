@@ -23,6 +23,7 @@ assemble / solve), the PG/O1 deviation and time ratios; writes
 out/cook_3d.png and a VTU with von Mises stress.
 
     python demos/cook_3d.py [--sizes 5 3.5 2.5] [--hex 8 12 16]
+        [--methods O1 "VC PBG Unl" "BCPPG Unl"]
 """
 import os
 
@@ -83,7 +84,15 @@ def run(sc, name, kw, label, w_ref, rows):
     return r
 
 
-def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None):
+def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None,
+         methods=None):
+    global METHODS
+    if methods:
+        unknown = set(methods) - set(METHODS)
+        if unknown or "O1" not in methods:
+            raise SystemExit("--methods: O1 and any of {} (got {})".format(
+                ", ".join(m for m in METHODS if m != "O1"), methods))
+        METHODS = {m: METHODS[m] for m in METHODS if m in methods}
     print(pg.threads.describe())
     ref = overkill(scene(cook3d(16, 4)), refine=0, method="H2")
     w_ref = ref.probes["corner"][2]
@@ -121,13 +130,16 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None):
         table = [[r["nodes"], r["label"], r["method"], "{:.5f}".format(r["w"]),
                   "{:.2e}".format(r["err"]),
                   "{:.2f}".format(wall_time(r))] for r in rows]
+        subset = methods and len(METHODS) < 3
         print("updated", update_results(
-            results, "cook_3d",
-            "`python demos/cook_3d.py --sizes {} --hex {}`: 3-D Cook's "
+            results, "cook_3d_large" if subset else "cook_3d",
+            "`python demos/cook_3d.py --sizes {} --hex {}{}`: 3-D Cook's "
             "membrane, iso/vol neo-Hooke, q = {} in z; H2 overkill w = "
             "{:.5f}; corner error and wall time.\n\n".format(
                 " ".join("{:g}".format(x) for x in sizes),
-                " ".join(str(n) for n in hexes), Q, w_ref)
+                " ".join(str(n) for n in hexes),
+                " --methods " + " ".join("'{}'".format(m) for m in METHODS)
+                if subset else "", Q, w_ref)
             + markdown_table(["nodes", "node set", "method", "w", "error",
                               "wall time [s]"], table)))
     os.makedirs(OUT, exist_ok=True)
@@ -147,6 +159,8 @@ if __name__ == "__main__":
                     help="gmsh mesh sizes of the tetrahedral node sets")
     ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16],
                     help="H1P0 hex grids n x n x n/4")
+    ap.add_argument("--methods", nargs="+", help="subset of the tetrahedral "
+                    "methods (O1 always): e.g. --methods O1 'VC PBG Unl'")
     args = ap.parse_args()
     OUT = output_dir(args.out)
-    main(args.sizes, args.hex, args.results)
+    main(args.sizes, args.hex, args.results, args.methods)
