@@ -153,6 +153,11 @@ def main():
                      "{} / {}".format(a["newton"], b["newton"]),
                      "{:.2f}".format(a["preprocess"])])
         print("  PG / {}: {} per iteration".format(fe, rows[-1][5]))
+        write(rows, args)  # after every node set: a cut run keeps its rows
+
+
+def write(rows, args):
+    """The results section of the rows so far."""
     table = markdown_table(
         ["nodes", "set", "FE", "FE [s/it]", "PG [s/it]", "PG / FE",
          "material", "assembly", "solve", "Krylov its PG / FE",
@@ -170,7 +175,7 @@ def main():
                 s=args.solver, l=args.load, n=args.steps,
                 t=pg.threads.describe(), tab=table))
     print(text)
-    print("updated", update_results(RESULTS, "newton_3d", text))
+    update_results(RESULTS, "newton_3d", text)
 
 
 if __name__ == "__main__":
