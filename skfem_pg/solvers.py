@@ -133,6 +133,13 @@ class AMGSolver:
       elasticity: 51 CG iterations with 6 candidates against 119 without,
       the setup 5.8 s against 1.7 s, so it pays from the first solve on
       and more so with a reused hierarchy).
+    * ``graph``: a sparse node adjacency (free nodes) whose standard
+      aggregates replace the tangent's on the first level, e.g. the
+      families' one-ring graph for PG, whose tangent couples two rings and
+      aggregates too coarsely (operator complexity 1.03).  On a 20.8k-node
+      cube (linear elasticity, one solve): 125 CG iterations against 213
+      without candidates, 58 against 108 with 6; not the default yet
+      (setup 16 s / 60 s against 10 s / 34 s, benchmarks/README.md).
     * Fallback chain: CG fails on indefinite tangents (past a limit point,
       or PG at an overshooting Newton iterate); then MINRES with the same
       (positive) preconditioner; above ``direct_limit`` unknowns GMRES with
@@ -144,9 +151,9 @@ class AMGSolver:
     def __init__(self, doflocs=None, tol=1e-10, symmetric=True,
                  smooth="energy", maxiter=500,
                  direct_limit=4 * DIRECT_LIMIT[3], ordering="auto",
-                 candidates=0):
+                 candidates=0, graph=None):
         self.doflocs, self.tol, self.symmetric = doflocs, tol, symmetric
-        self.candidates = int(candidates)
+        self.candidates, self.graph = int(candidates), graph
         self.smooth, self.maxiter = smooth, maxiter
         self.direct_limit, self.ordering = direct_limit, ordering
         self.ml, self.base_its, self.stale, self.t_setup = None, None, \
@@ -170,6 +177,14 @@ class AMGSolver:
             kw["improve_candidates"] = [
                 ("block_gauss_seidel" if bs > 1 else "gauss_seidel",
                  {"sweep": "symmetric", "iterations": 10}), None]
+        if self.graph is not None and bs > 1 \
+                and self.graph.shape[0] == A.shape[0] // bs:
+            # first-level aggregates on the given node graph (PG: the
+            # families', one ring) instead of the tangent's (two rings)
+            from pyamg.aggregation.aggregate import standard_aggregation
+            agg, _ = standard_aggregation(self.graph.tocsr())
+            kw["aggregate"] = [("predefined", {"AggOp": agg.tocsr()})] \
+                + ["standard"] * 9
         self.ml = pyamg.smoothed_aggregation_solver(
             M, B=B, smooth=self.smooth,
             symmetry="hermitian" if self.symmetric else "nonsymmetric", **kw)
