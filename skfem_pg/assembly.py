@@ -22,9 +22,10 @@ scalars).  The local matrices
 
 (a form may instead provide them as ``form.coefficients(w, c, d + 1)``,
 shape ``(ne, nq, c(d+1), c(d+1))``, or as a pair ``(C, channels)`` with
-``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed) are batched matrix products, scattered
-into a block sparsity pattern that is
-computed once per basis.  For a family basis ``k`` is a family, ``j`` a
+``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed)
+are batched matrix products, one batch per block of equal local size (for
+family bases the size groups of :mod:`skfem_pg.layout`: no padding),
+scattered into a block sparsity pattern that is computed once per basis.  For a family basis ``k`` is a family, ``j`` a
 member (quadrature point) and ``i`` a member (basis function) with
 :math:`N^{kji} = \delta_{ij}`; for a scikit-fem cell basis ``k`` is an
 element, ``j`` a quadrature point and ``i`` a scalar shape function — the
@@ -45,9 +46,9 @@ from .threads import kernel
 
 class _Block:
     """Elements of equal local size: ``conn`` ``(ne_b, nloc)`` node
-    indices, ``dx`` ``(ne_b, nq)`` weights, ``grads`` the per-element
-    derivative array or callable behind ``ext_grad``, ``take`` the
-    restriction of a quadrature-point array (point axes first) to the
+    indices, ``dx`` ``(ne_b, nq)`` weights, ``ext_grad(sl, channels)``
+    the values/derivatives ``Ĝ[k, j, i, β]`` of elements ``sl``, ``take``
+    the restriction of a quadrature-point array (point axes first) to the
     block; ``index`` its elements (families) in the basis, ``G`` and
     ``group`` (family blocks) its unpadded derivatives and size group."""
 
