@@ -85,7 +85,7 @@ def run(sc, name, kw, label, w_ref, rows):
 
 
 def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None,
-         methods=None):
+         methods=None, section=None):
     global METHODS
     if methods:
         unknown = set(methods) - set(METHODS)
@@ -132,7 +132,7 @@ def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None,
                   "{:.2f}".format(wall_time(r))] for r in rows]
         subset = methods and len(METHODS) < 3
         print("updated", update_results(
-            results, "cook_3d_large" if subset else "cook_3d",
+            results, section or ("cook_3d_large" if subset else "cook_3d"),
             "`python demos/cook_3d.py --sizes {} --hex {}{}`: 3-D Cook's "
             "membrane, iso/vol neo-Hooke, q = {} in z; H2 overkill w = "
             "{:.5f}; corner error and wall time.\n\n".format(
@@ -161,6 +161,9 @@ if __name__ == "__main__":
                     help="H1P0 hex grids n x n x n/4")
     ap.add_argument("--methods", nargs="+", help="subset of the tetrahedral "
                     "methods (O1 always): e.g. --methods O1 'VC PBG Unl'")
+    ap.add_argument("--section", help="benchmarks/README.md section the "
+                    "--results table goes to (default cook_3d, or "
+                    "cook_3d_large with --methods)")
     args = ap.parse_args()
     OUT = output_dir(args.out)
-    main(args.sizes, args.hex, args.results, args.methods)
+    main(args.sizes, args.hex, args.results, args.methods, args.section)

@@ -129,10 +129,13 @@ class AMGSolver:
       Gauss-Seidel sweeps, join the rigid-body modes as near-null-space
       candidates: PG tangents have many soft modes (Jacobi-scaled
       condition number 8e4 against O1's 2e3 on a 1.2k-node cube), which
-      the rigid-body modes alone leave to CG (7.4k-node cube, linear
-      elasticity: 51 CG iterations with 6 candidates against 119 without,
-      the setup 5.8 s against 1.7 s, so it pays from the first solve on
-      and more so with a reused hierarchy).
+      the rigid-body modes alone leave to CG.  Cube, linear elasticity,
+      one solve, CG iterations / setup: 6.9k free nodes 51 / 4.9 s with
+      6 candidates, 30 / 9.4 s with 12, 21 / 12.0 s with 18 (O1 14 /
+      1.0 s); 19.7k free nodes 108 / 34 s with 6, 55 / 27 s with 12,
+      29-34 / 45 s with 18 (O1 16 / 2.5 s).  Without the Gauss-Seidel
+      smoothing, or with Jacobi or Chebyshev instead, 18 candidates need
+      48-60 iterations on the 6.9k set (benchmarks/README.md).
     * ``graph``: a sparse node adjacency (free nodes) whose standard
       aggregates replace the tangent's on the first level, e.g. the
       families' one-ring graph for PG, whose tangent couples two rings and
@@ -347,8 +350,9 @@ def _vector(v, N, what):
 
 
 #: extra smoothed random near-null-space candidates of the AMG hierarchy
-#: for family bases (:class:`AMGSolver`)
-PG_CANDIDATES = 6
+#: for family bases (:class:`AMGSolver`): 18 trades the longest setup for
+#: the fewest iterations, which pays once Newton reuses the hierarchy
+PG_CANDIDATES = 18
 
 
 def _condensed_solver(kind, basis, I):
