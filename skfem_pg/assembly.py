@@ -283,7 +283,8 @@ def block_pattern(basis, view=None):
                        + conn[sl, None, :]).ravel()
                 u, inv = np.unique(np.searchsorted(keys, loc),
                                    return_inverse=True)
-                pieces.append((bi, sl, u, inv.astype(np.int64)))
+                pieces.append((bi, sl, u, inv.astype(
+                    np.int32 if len(u) < 2 ** 31 else np.int64)))
         basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces, {})
     return basis._pattern
 
