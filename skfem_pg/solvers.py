@@ -201,8 +201,9 @@ class AMGSolver:
         hierarchy was not built from) preconditioned by one V-cycle."""
         from pyamg import krylov
         res = []
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # CG's indefinite note
+        # CG's indefinite note: pyamg re-enables it with an 'always' filter
+        # inside the call, so record (and drop) instead of ignoring
+        with warnings.catch_warnings(record=True):
             x, _ = getattr(krylov, accel)(
                 A, b, x0=x0, tol=self.tol, M=self.ml.aspreconditioner(),
                 maxiter=min(self.maxiter, A.shape[0]), residuals=res)
