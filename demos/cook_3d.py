@@ -163,7 +163,7 @@ if __name__ == "__main__":
                     "methods (O1 always): e.g. --methods O1 'VC PBG Unl'")
     ap.add_argument("--section", help="benchmarks/README.md section the "
                     "--results table goes to (default cook_3d, or "
-                    "cook_3d_large with --methods)")
+                    "cook_3d_large with fewer --methods)")
     args = ap.parse_args()
     OUT = output_dir(args.out)
     main(args.sizes, args.hex, args.results, args.methods, args.section)
