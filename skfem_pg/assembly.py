@@ -25,9 +25,10 @@ shape ``(ne, nq, c(d+1), c(d+1))``, or as a pair ``(C, channels)`` with
 ``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed)
 are batched matrix products, one batch per block of equal local size (for
 family bases the size groups of :mod:`skfem_pg.layout`: no padding),
-scattered into a block sparsity pattern that is computed once per basis.  For a family basis ``k`` is a family, ``j`` a
-member (quadrature point) and ``i`` a member (basis function) with
-:math:`N^{kji} = \delta_{ij}`; for a scikit-fem cell basis ``k`` is an
+scattered into a block sparsity pattern that is computed once per basis.
+For a family basis ``k`` is a family, ``j`` a member (quadrature point)
+and ``i`` a member (basis function) with :math:`N^{kji} = \delta_{ij}`;
+for a scikit-fem cell basis ``k`` is an
 element, ``j`` a quadrature point and ``i`` a scalar shape function — the
 same code assembles FE comparators.  Forms that use more than values and
 gradients (``hess`` ...) raise; use ``form.assemble(basis)`` for those.

@@ -11,6 +11,7 @@ Newton diverges, exceeds ``maxiter`` or meets :math:`J \le 0` anywhere; a
 :class:`ConvergenceError` names the load factor once the step would fall
 below ``min_step``.
 """
+import inspect
 import time
 import warnings
 
@@ -110,6 +111,11 @@ def _node_blocks(doflocs):
         return 1
     X = doflocs.reshape(d, -1, d)
     return d if np.all(X == X[:, :, :1]) else 1
+
+
+#: MINRES' tolerance keyword (scipy < 1.12: ``tol``)
+_MINRES_TOL = ("rtol" if "rtol" in inspect.signature(spl.minres).parameters
+               else "tol")
 
 
 class AMGSolver:
@@ -217,13 +223,10 @@ class AMGSolver:
 
         def count(xk):
             its[0] += 1
-        import inspect
-        key = ("rtol" if "rtol" in inspect.signature(spl.minres).parameters
-               else "tol")  # scipy < 1.12: tol
         try:
             x, _ = spl.minres(A, b, M=self.ml.aspreconditioner(),
                               maxiter=min(self.maxiter, A.shape[0]),
-                              callback=count, **{key: self.tol})
+                              callback=count, **{_MINRES_TOL: self.tol})
         except ValueError:  # a hierarchy built from an indefinite matrix
             return None, its[0], False, np.inf
         rel = np.linalg.norm(b - A @ x) / max(np.linalg.norm(b), 1e-300)
@@ -263,15 +266,15 @@ class AMGSolver:
             self.stats["iterations"][-1] += its
             if ok:
                 return x
+        tried = ["CG", "MINRES"] if accel == "cg" else [accel.upper()]
         if A.shape[0] > self.direct_limit and accel == "cg":
+            tried.append("GMRES")
             x, its, ok, rel = self._krylov(A, b, "gmres")
             self.stats["iterations"][-1] += its
             if ok:
                 return x
         warnings.warn("AMG-{} failed (relative residual {:.2e}); solving "
-                      "directly".format(
-                          "CG and MINRES" if accel == "cg" else
-                          accel.upper(), rel))
+                      "directly".format(", ".join(tried), rel))
         self.ml = None  # the next tangent gets a fresh hierarchy
         return direct(A, b, self.ordering)
 
