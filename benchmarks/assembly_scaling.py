@@ -19,9 +19,10 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")  # the measured tables, written here

@@ -21,7 +21,7 @@ the geometric nonlinearity:
    2 agrees to 0.07 %), for O1 and PG on the same gmsh tetrahedra, with
    wall time.
 
-Node sets: gmsh tetrahedra (``skfem_pg/meshes/cook3d.geo``, ``--sizes``) and
+Node sets: gmsh tetrahedra (``skfem_pg/scenes/meshes/cook3d.geo``, ``--sizes``) and
 regular hexahedral grids split into tetrahedra (``--grids``), distorted by
 ±0.3h.  Writes ``out/bending_3d.png``.
 
@@ -36,12 +36,13 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture
-from skfem_pg.scenes import Scene, _transfer_boundaries
+from skfem_pg.scenes import Scene
+from skfem_pg.scenes.scene import _transfer_boundaries
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "demos"))

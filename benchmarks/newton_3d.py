@@ -5,7 +5,7 @@ internal force, tangent) and the linear solve.
 
 The problem is the 3-D Cook's membrane of ``demos/cook_3d.py`` (iso/vol
 neo-Hooke, lambda = 100, mu = 40, load on the far face) at ``--load`` of
-its load in ``--steps`` load steps, solved by ``skfem_pg.newton`` with one
+its load in ``--steps`` load steps, solved by ``skfem_pg.solvers.newton`` with one
 linear solver per method (AMG keeps its hierarchy across iterations).
 Times are per Newton iteration, failed load steps included; ratios against
 the FE method on the same nodes in the same run.
@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import skfem_pg as pg
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg.scenes import Scene
 
@@ -61,7 +61,7 @@ class Timed:
 
 
 def iterations(sc, scheme, solver, load, steps, **kw):
-    """Newton's method (``skfem_pg.newton``) on the scene at ``load`` times
+    """Newton's method (``skfem_pg.solvers.newton``) on the scene at ``load`` times
     its load in ``steps`` steps; per-iteration means of the phases (failed
     load steps included), the Krylov iterations per solve and the basis'
     preprocessing."""
@@ -70,7 +70,7 @@ def iterations(sc, scheme, solver, load, steps, **kw):
     model.material = material
     timed = Timed(model, ("state", "internal_force", "tangent"))
     I = np.setdiff1d(np.arange(basis.N), D)
-    lin = pg.solvers._condensed_solver(solver, basis, I)
+    lin = pg.solvers.static._condensed_solver(solver, basis, I)
     t_lin = [0.0]
 
     def solve(A, b):
@@ -164,7 +164,7 @@ def write(rows, args):
          "Newton its PG / FE", "PG preprocess [s]"],
         [[r[1], r[0]] + r[2:] for r in rows])
     text = ("`python benchmarks/newton_3d.py --solver {s} --load {l} "
-            "--steps {n}`: `skfem_pg.newton` on the 3-D Cook's membrane of "
+            "--steps {n}`: `skfem_pg.solvers.newton` on the 3-D Cook's membrane of "
             "`demos/cook_3d.py` at {l} of its load in {n} load steps; PG = "
             "VC PBG Unl on the FE mesh's nodes. Seconds per Newton "
             "iteration (failed load steps included) and the PG/FE ratios "

@@ -36,7 +36,8 @@ def one(size):
     """Everything for one mesh size; returns a dict (run in a child)."""
     import skfem as fem
     import skfem_pg as pg
-    from skfem_pg.models import lame, linear_elasticity
+    from skfem_pg.materials import lame
+    from skfem_pg.formulations import linear_elasticity
     from skfem_pg.solvers import linear_solver
     r = {"size": size}
     mesh, r["mesh"] = clock(pg.meshing.from_geo,
@@ -81,7 +82,7 @@ def one(size):
 
 
 def main():
-    from skfem_pg.reporting import demo_parser, markdown_table, \
+    from skfem_pg.scenes.reporting import demo_parser, markdown_table, \
         update_results
     import skfem_pg as pg
     p = demo_parser(__doc__)

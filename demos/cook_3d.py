@@ -3,7 +3,7 @@ irregular tetrahedral node sets, H1P0 on distorted hexahedral grids, error
 against wall time.
 
 The 2-D outline (0,0), (48,44), (48,60), (0,44) extruded by a thickness of
-10 in z (``skfem_pg/meshes/cook3d.geo``); clamped at x = 0; a dead area load q = 4
+10 in z (``skfem_pg/scenes/meshes/cook3d.geo``); clamped at x = 0; a dead area load q = 4
 in +z on the face x = 48 (thesis 7.1).  The thesis' figure with thickness
 and material is not in the text: we use thickness 10 and the iso/vol
 neo-Hooke (2.43) with lambda = 100, mu = 40 (the 2-D Cook's constants), so
@@ -32,9 +32,9 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.postprocess import particle_fields
-from skfem_pg.reference import overkill
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.analysis.postprocess import particle_fields
+from skfem_pg.scenes.reference import overkill
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 print_time_to_target, save_error_vs_time,
                                 update_results, wall_time)
 from skfem_pg.scenes import Scene

@@ -26,9 +26,10 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
-from skfem_pg.models import lame, linear_elasticity
-from skfem_pg.reporting import plot_error_vs_time
+from skfem_pg.scenes.reporting import demo_parser, output_dir
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
+from skfem_pg.scenes.reporting import plot_error_vs_time
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 POINT = np.array([48.0, 52.0])

@@ -9,7 +9,7 @@ clearly nonlinear.  Quantity: vertical displacement of the top-right corner
 (48, 60), compared with a T2 overkill solution (cached in
 ~/.cache/skfem_pg, or $SKFEM_PG_CACHE).
 
-Methods on each node set (skfem_pg/meshes/cook.geo, element sizes --sizes):
+Methods on each node set (skfem_pg/scenes/meshes/cook.geo, element sizes --sizes):
   T1                       scikit-fem P1 triangles, consistent tangent
   PBG Unl                  MTE1 + bond correction, no VC
   VC PBG Unl               MTE1 + bond correction + V5 (default FamilyBasis)
@@ -29,9 +29,9 @@ import os
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.postprocess import particle_fields
-from skfem_pg.reference import overkill
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.analysis.postprocess import particle_fields
+from skfem_pg.scenes.reference import overkill
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 print_time_to_target, save_error_vs_time,
                                 update_results, wall_time)
 from skfem_pg.scenes import Scene

@@ -18,10 +18,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
-from skfem_pg.reporting import save_figure
-from skfem_pg.models import lame, linear_elasticity
-from skfem_pg.spectrum import classify, free_modes
+from skfem_pg.scenes.reporting import demo_parser, output_dir
+from skfem_pg.scenes.reporting import save_figure
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
+from skfem_pg.analysis.spectrum import classify, free_modes
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 

@@ -6,7 +6,7 @@ a central hole of radius a = 1 under uniaxial tension σ∞ = 1 in x, linear
 elastic (E = 1000, ν = 0.3, plane strain: strains of 1e-3).  The quarter
 x, y ≥ 0 is modelled with symmetry conditions on both cut lines (u_x = 0 on
 x = 0, u_y = 0 on y = 0), the traction on x = L.  Structured, radially graded quadrilaterals
-(``skfem_pg.meshing.plate_with_hole``).  PPG particles collocated from the
+(``skfem_pg.scenes.meshing.plate_with_hole``).  PPG particles collocated from the
 cells within r < 2.5 a (the high stresses around the hole), Q1 elements
 elsewhere, coupled only through the shared interface nodes.
 
@@ -30,9 +30,10 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.models import lame, linear_elasticity
-from skfem_pg.reference import overkill
-from skfem_pg.reporting import (demo_parser, markdown_table, output_dir,
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
+from skfem_pg.scenes.reference import overkill
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg.scenes import Scene
 
@@ -96,7 +97,7 @@ def line_stress(mesh, u, pgb, lam, mu):
         pg_nodes[masters] = True
         grad = pgb.interpolate(u).grad[:, :, :, 0]
         sxx_pg[masters] = stress(grad, lam, mu)
-    ref = pg.reference.Reference(mesh, "Q1", u, {})
+    ref = pg.scenes.reference.Reference(mesh, "Q1", u, {})
     for line, axis in (("x = 0", 0), ("y = 0", 1)):
         nodes = np.nonzero(np.abs(mesh.p[axis]) < 1e-9)[0]
         nodes = nodes[np.argsort(mesh.p[1 - axis, nodes])]

@@ -26,12 +26,12 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
+from skfem_pg.scenes.reporting import demo_parser, output_dir
 from skfem_pg import materials as mat
-from skfem_pg.mechanics import Hyperelastic
-from skfem_pg.particles import inverted_cells
-from skfem_pg.reporting import markdown_table, update_results
-from skfem_pg.postprocess import particle_fields
+from skfem_pg.formulations import Hyperelastic
+from skfem_pg.discretization.particles import inverted_cells
+from skfem_pg.scenes.reporting import markdown_table, update_results
+from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.solvers import newton, ConvergenceError
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -69,7 +69,7 @@ def compress(basis, material, min_step=1e-3):
 
 
 def main(nx=64, ny=32, results=None):
-    lam, mu = pg.models.lame(E, NU)
+    lam, mu = pg.materials.lame(E, NU)
     material = mat.NeoHooke(lam, mu)
     mesh = block(nx, ny)
     runs = {

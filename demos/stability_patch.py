@@ -26,13 +26,13 @@ import numpy as np
 import scipy.sparse.linalg as spl
 
 import skfem_pg as pg
-from skfem_pg.reporting import demo_parser, output_dir
-from skfem_pg.reporting import save_figure
+from skfem_pg.scenes.reporting import demo_parser, output_dir
+from skfem_pg.scenes.reporting import save_figure
 from skfem_pg import materials as mat
-from skfem_pg.mechanics import Hyperelastic
-from skfem_pg.models import lame
-from skfem_pg.shape import mls1_master_values
-from skfem_pg.spectrum import classify, free_modes
+from skfem_pg.formulations import Hyperelastic
+from skfem_pg.materials import lame
+from skfem_pg.discretization.shape import mls1_master_values
+from skfem_pg.analysis.spectrum import classify, free_modes
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 FORMULATIONS = {"U1 (WTE1)": dict(shape="WTE1"), "VC PBG Unl": dict()}

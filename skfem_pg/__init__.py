@@ -3,30 +3,37 @@
 Particle families are scikit-fem elements: a :class:`FamilyBasis` plugs into
 scikit-fem's own assembly, so the same ``BilinearForm`` assembles FE and PG.
 
+The subpackages follow the data flow: :mod:`~skfem_pg.discretization`
+(particles, families, shape functions, corrections, ``FamilyBasis``,
+assembly) → :mod:`~skfem_pg.formulations` (with :mod:`~skfem_pg.materials`)
+→ :mod:`~skfem_pg.solvers` → :mod:`~skfem_pg.analysis` and
+:mod:`~skfem_pg.scenes`.
+
 >>> import numpy as np, skfem as fem, skfem_pg as pg
 >>> mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
 >>> basis = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
 >>> basis.vc_report.residual_after < 1e-10
 True
 """
-from . import (families, shape, corrections, meshing, materials, solvers,
-               models, threads)
+from . import (discretization, formulations, materials, solvers, analysis,
+               scenes, threads, errors)
+from .discretization import (particles, families, shape, corrections,
+                             loads)
+from .scenes import meshing, reference, reporting
 from .errors import (ParticleError, FamilyError, CorrectionError,
                      UnsupportedMeshError, SlowAssemblyWarning)
-from .particles import Particles
-from .families import Families
-from .basis import FamilyBasis
-from .assembly import assemble, block_pattern
-from .forms import BilinearForm, LinearForm
-from .loads import traction, stress_load, body_force
-from .io import write_vtu
+from .discretization import (Particles, Families, FamilyBasis, assemble,
+                             block_pattern, BilinearForm, LinearForm,
+                             traction, stress_load, body_force)
+from .scenes.io import write_vtu
 
 __version__ = "0.1.0"
 
 __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "BilinearForm", "LinearForm", "SlowAssemblyWarning",
            "block_pattern", "traction", "stress_load", "body_force",
-           "write_vtu", "families", "shape", "corrections", "meshing",
-           "materials", "solvers", "models",
+           "write_vtu", "discretization", "formulations", "materials",
+           "solvers", "analysis", "scenes", "families", "shape",
+           "corrections", "meshing", "particles", "loads",
            "ParticleError", "FamilyError", "CorrectionError",
            "UnsupportedMeshError"]

@@ -5,7 +5,8 @@ import skfem as fem
 from skfem.helpers import dot, grad, ddot, sym_grad, transpose, mul
 
 import skfem_pg as pg
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 from conftest import square, cube
 
 
@@ -101,7 +102,7 @@ def test_fe_cell_bases_fast_equals_generic(mesh_elem):
     F = vb.interpolate(0.05 * rng.standard_normal(vb.N)).grad \
         + np.eye(d)[:, :, None, None]
     from skfem_pg.materials import NeoHooke
-    from skfem_pg.mechanics import material_tangent, internal_force
+    from skfem_pg.formulations import material_tangent, internal_force
     A = NeoHooke(3.0, 1.0).tangent(F)
     P = NeoHooke(3.0, 1.0).stress(F)
     assert rel(pg.assemble(material_tangent, vb, A=A),

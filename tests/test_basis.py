@@ -7,8 +7,9 @@ from skfem.helpers import ddot, sym_grad
 
 import skfem_pg as pg
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
-from skfem_pg.corrections import anchor_particles
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.discretization.corrections import anchor_particles
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 from conftest import square
 
 

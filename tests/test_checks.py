@@ -6,8 +6,9 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.mechanics import Hyperelastic
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.formulations import Hyperelastic
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 
 
 @pytest.mark.parametrize("E, nu, match", [

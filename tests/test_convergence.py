@@ -5,8 +5,8 @@ import pytest
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.convergence import PlaneWaves, rates, solve_manufactured
-from skfem_pg.models import lame
+from skfem_pg.analysis.convergence import PlaneWaves, rates, solve_manufactured
+from skfem_pg.materials import lame
 
 LAM, MU = lame(100e3, 0.3)
 FIELD = PlaneWaves.hillman2019()

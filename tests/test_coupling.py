@@ -5,7 +5,8 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 from conftest import square
 
 

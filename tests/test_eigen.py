@@ -5,7 +5,8 @@ import scipy.linalg
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 
 
 @pytest.fixture(scope="module")
@@ -45,11 +46,11 @@ def test_u1_has_spurious_soft_modes(block):
 
 
 def test_spectrum_tool_and_ppg_stability(block):
-    """Free-block spectra with :mod:`skfem_pg.spectrum` (lumped mass):
+    """Free-block spectra with :mod:`skfem_pg.analysis.spectrum` (lumped mass):
     default VC PPG Unl (with bond correction) is stable like VC PBG Unl;
     without bond correction its non-symmetric tangent has eigenvalues with
     negative real part (measured: 6, the lowest -18.9)."""
-    from skfem_pg.spectrum import classify, free_modes
+    from skfem_pg.analysis.spectrum import classify, free_modes
     mesh, form, _ = block
     p = pg.Particles.from_mesh(mesh)
     M = np.repeat(p.volumes, 2)
@@ -72,7 +73,7 @@ def test_spectrum_tool_and_ppg_stability(block):
 def test_random_centroid_patch_u1_soft_unl_stable():
     """Seed 002's patch: ~450 centroids of irregular gmsh quads, 12
     nearest neighbours.  Measured: U1 137 soft modes, VC PBG Unl none."""
-    from skfem_pg.spectrum import free_modes
+    from skfem_pg.analysis.spectrum import free_modes
     mesh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"), size=0.11,
                                recombine=True)
     p = pg.Particles.from_mesh(mesh, kind="centroids")

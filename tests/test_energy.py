@@ -7,8 +7,8 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis import (discrete_energy, energy_capture,
                                nodal_interpolant)
-from skfem_pg.assembly import assemble
-from skfem_pg.models import linear_elasticity
+from skfem_pg.discretization.assembly import assemble
+from skfem_pg.formulations import linear_elasticity
 from conftest import cube
 
 LAM, MU = 100.0, 40.0

@@ -5,7 +5,7 @@ import pytest
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.infsup import infsup_fe, infsup_pg
+from skfem_pg.analysis.infsup import infsup_fe, infsup_pg
 
 
 def square(N, distortion=0.0):

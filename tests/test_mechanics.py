@@ -5,7 +5,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.mechanics import Hyperelastic, MeanDilatation
+from skfem_pg.formulations import Hyperelastic, MeanDilatation
 from skfem_pg.solvers import newton
 
 

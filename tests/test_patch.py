@@ -169,8 +169,9 @@ def test_vc2_ppg_v1s_u2_passes_the_quadratic_patch_test():
                                      vc="VC2")
     assert r_all["basis"].vc_report.residual_after < 1e-8
     # the warning is earned: negative-real eigenvalues of the free tangent
-    from skfem_pg.spectrum import free_modes
-    from skfem_pg.models import lame, linear_elasticity
+    from skfem_pg.analysis.spectrum import free_modes
+    from skfem_pg.materials import lame
+    from skfem_pg.formulations import linear_elasticity
     b = r["basis"]
     K = pg.assemble(linear_elasticity(*lame(1.0, 0.4)), b)
     lam = np.asarray(free_modes(K, np.repeat(b.particles.volumes, 2))[
@@ -178,7 +179,7 @@ def test_vc2_ppg_v1s_u2_passes_the_quadratic_patch_test():
     assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
     # the constraints hold in the bond-pair (element) view that assembles
     # PPG1, not only in the master view they were solved in
-    from skfem_pg.vc2 import vc2_residuals
+    from skfem_pg.discretization.vc2 import vc2_residuals
     b = r["basis"]
     p = b.particles
     r1, r2 = vc2_residuals(b.test.G, b.dx, b.families, p.x, p.volumes,

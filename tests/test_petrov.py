@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 
 import skfem_pg as pg
-from skfem_pg import petrov
+from skfem_pg.discretization import petrov
 from skfem_pg.analysis import linear_patch_test
-from skfem_pg.corrections import constraint_residual
-from skfem_pg.models import lame, linear_elasticity
+from skfem_pg.discretization.corrections import constraint_residual
+from skfem_pg.materials import lame
+from skfem_pg.formulations import linear_elasticity
 from conftest import square, cube
 from test_patch import MESHES_2D, MESHES_3D, TOP
 
@@ -76,7 +77,7 @@ def test_families_are_completed_pairwise():
 def test_ppg1_newton_small_load_matches_linear_and_amg_gmres():
     import skfem as fem
     from skfem_pg import materials as mat
-    from skfem_pg.mechanics import Hyperelastic
+    from skfem_pg.formulations import Hyperelastic
     from skfem_pg.solvers import newton, linear_solver
     mesh = pg.meshing.distort(fem.MeshQuad.init_tensor(
         np.linspace(0, 4, 17), np.linspace(0, 1, 5)), 0.3, seed=1)
@@ -117,14 +118,14 @@ def test_vc_ppg2_passes_the_patch_test_but_is_unstable():
     assert np.abs(res).max() < 1e-12
     # the warning is earned: the free tangent has eigenvalues with negative
     # real part (measured 18 on this distorted set)
-    from skfem_pg.spectrum import free_modes
+    from skfem_pg.analysis.spectrum import free_modes
     K = pg.assemble(linear_elasticity(*lame(1.0, 0.4)), b)
     lam = free_modes(K, np.repeat(b.particles.volumes, 2))["eigenvalues"]
     assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
 
 
 def test_lme_test_functions():
-    from skfem_pg.shape.lme import lme_master_gradients
+    from skfem_pg.discretization.shape.lme import lme_master_gradients
     mesh = square(8, 0.3, seed=1)
     p = pg.Particles.from_mesh(mesh)
     fam = pg.families.from_mesh(p)
@@ -148,7 +149,7 @@ def test_lme_test_functions():
 @pytest.mark.parametrize("kw", [dict(test_shape="WLS1"),
                                 dict(test_shape="WTE1", shape="WTE2")])
 def test_other_test_functions_pass_the_patch_test(kw):
-    from skfem_pg.shape.least_squares import wls1_master_gradients
+    from skfem_pg.discretization.shape.least_squares import wls1_master_gradients
     mesh = square(8, 0.3, seed=1)
     r = linear_patch_test(mesh, TOP[2], method="PPG1", **kw)
     assert r["max_error"] <= 1e-10

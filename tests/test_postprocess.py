@@ -4,7 +4,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.postprocess import particle_fields
+from skfem_pg.analysis.postprocess import particle_fields
 
 
 def test_homogeneous_stretch_gives_exact_fields(tmp_path):

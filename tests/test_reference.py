@@ -6,7 +6,7 @@ import pytest
 import skfem as fem
 
 from skfem_pg import materials as mat
-from skfem_pg.reference import cache_dir, overkill
+from skfem_pg.scenes.reference import cache_dir, overkill
 from skfem_pg.scenes import Scene
 
 

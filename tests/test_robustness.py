@@ -78,7 +78,8 @@ def test_fe_passes_the_patch_test_on_the_same_sets(name):
     reference behaviour the issue names)."""
     from skfem.helpers import dot
     from skfem_pg.analysis import PATCH_GRADIENT_2D, PATCH_GRADIENT_3D
-    from skfem_pg.models import lame, linear_elasticity
+    from skfem_pg.materials import lame
+    from skfem_pg.formulations import linear_elasticity
     mesh = SETS[name]()
     d = mesh.dim()
     e1, _ = pg.particles.linear_elements(mesh)
@@ -116,7 +117,7 @@ def test_too_few_nearest_neighbours_raise(k):
 
 
 def test_blown_up_corrections_raise():
-    from skfem_pg.corrections import GRADIENT_LIMIT, check_correction
+    from skfem_pg.discretization.corrections import GRADIENT_LIMIT, check_correction
     mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5),
                                     np.linspace(0, 1, 5))
     b = pg.FamilyBasis(mesh, dim=2)
@@ -168,7 +169,7 @@ def test_folded_triangle_mesh_is_rejected():
 
 @pytest.mark.parametrize("kind", ["quad", "tri"])
 def test_inverted_cells_of_a_particle_displacement(kind):
-    from skfem_pg.particles import inverted_cells
+    from skfem_pg.discretization.particles import inverted_cells
     g = np.linspace(0, 1, 5)
     mesh = (fem.MeshQuad if kind == "quad" else fem.MeshTri).init_tensor(g, g)
     p = pg.Particles.from_mesh(mesh)

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import skfem_pg as pg
-from skfem_pg.corrections import bond_correction
+from skfem_pg.discretization.corrections import bond_correction
 from conftest import square, cube
 
 
@@ -82,7 +82,7 @@ def test_vc_corrected_gradients_stay_consistent(d):
 
 @pytest.mark.parametrize("d", [2, 3])
 def test_wte2_reproduces_quadratic_gradients(d):
-    from skfem_pg.shape import wte2_gradients
+    from skfem_pg.discretization.shape import wte2_gradients
     if d == 2:
         mesh = square(8, 0.3, seed=1)
     else:
@@ -110,7 +110,7 @@ def test_least_squares_master_derivatives(d):
     """WLS1/MLS1 gradients reproduce linear fields, WLS2 gradients and
     Hessians (the V2 correction functions) quadratic ones; MLS1 against
     finite differences of the moving fit."""
-    from skfem_pg.shape import least_squares as ls
+    from skfem_pg.discretization.shape import least_squares as ls
     p = random_particles(d, n=80, seed=7)
     fam = pg.families.nearest(p, 14 if d == 2 else 24)
     mem, mask = fam.padded()

@@ -5,8 +5,8 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
-from skfem_pg.models import linear_elasticity
-from skfem_pg.mechanics import Hyperelastic
+from skfem_pg.formulations import linear_elasticity
+from skfem_pg.formulations import Hyperelastic
 from skfem_pg.solvers import newton, linear_solver, ConvergenceError
 
 LAM, MU = 100.0, 40.0
@@ -115,8 +115,8 @@ def test_amg_with_rigid_body_modes_matches_direct():
 
 
 def test_fd_tangent_matches_consistent_tangent(beam):
-    from skfem_pg.mechanics import material_tangent
-    from skfem_pg.tangents import fd_tangent
+    from skfem_pg.formulations import material_tangent
+    from skfem_pg.formulations.tangents import fd_tangent
     mesh, b = beam
     rng = np.random.default_rng(2)
     u = 0.02 * rng.standard_normal(b.N)

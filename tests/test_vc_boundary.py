@@ -6,7 +6,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.analysis import linear_patch_test
-from skfem_pg.loads import stress_load
+from skfem_pg.discretization.loads import stress_load
 from conftest import square, cube
 from test_patch import TOP, MESHES_2D, MESHES_3D
 
@@ -60,12 +60,12 @@ def test_released_constraints_need_discrete_loads():
     makes it pass."""
     mesh = square(10, 0.3, seed=1)
     g = pg.analysis.PATCH_GRADIENT_2D
-    lam, mu = pg.models.lame(100.0, 0.3)
+    lam, mu = pg.materials.lame(100.0, 0.3)
     eps = 0.5 * (g + g.T)
     sigma = 2 * mu * eps + lam * np.trace(eps) * np.eye(2)
     b = pg.FamilyBasis(mesh, dim=2, vc_boundary="s")
     top = mesh.facets_satisfying(TOP[2])
-    K = pg.assemble(pg.models.linear_elasticity(lam, mu), b)
+    K = pg.assemble(pg.formulations.linear_elasticity(lam, mu), b)
     D = b.get_dofs(np.setdiff1d(mesh.boundary_facets(), top))
     uex = (g @ mesh.p).T.ravel()
     f = stress_load(b, top, sigma)

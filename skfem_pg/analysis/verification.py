@@ -13,11 +13,12 @@ quadrature:
 import numpy as np
 import skfem as fem
 
-from .basis import FamilyBasis, pbg_weights
-from .assembly import assemble
-from .loads import stress_load
-from .models import lame, linear_elasticity
-from .particles import Particles, linear_elements
+from ..discretization.basis import FamilyBasis, pbg_weights
+from ..discretization.assembly import assemble
+from ..discretization.loads import stress_load
+from ..materials.constants import lame
+from ..formulations.linear import linear_elasticity
+from ..discretization.particles import Particles, linear_elements
 
 #: displacement gradient of the thesis' linear patch test (7.1)
 PATCH_GRADIENT_2D = np.array([[0.1, 0.3], [0.2, 0.4]])

@@ -355,8 +355,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     G
         ``(nf, m, m, d)`` derivatives (bond corrected for V5).  Unpadded:
         ``G``, ``dx``, ``fam`` and ``phi`` may instead be lists with one
-        entry per size group (:mod:`skfem_pg.layout`; ``fam`` the groups'
-        :meth:`~skfem_pg.layout.SizeGroups.subset` families) and ``index``
+        entry per size group (:mod:`skfem_pg.discretization.layout`; ``fam`` the groups'
+        :meth:`~skfem_pg.discretization.layout.SizeGroups.subset` families) and ``index``
         the groups' family indices; the corrected ``G`` is then a list
         too.
     dx
@@ -364,7 +364,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     x, volumes
         Particle positions ``(d, np)`` and volumes.
     fam
-        :class:`~skfem_pg.families.Families`.
+        :class:`~skfem_pg.discretization.families.Families`.
     area
         ``(d, np)`` area vectors :math:`A^i`.
     phi
@@ -390,7 +390,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         whose equations are eliminated); needed by V4 for round-off
         patch tests.
     boundary
-        How the singular system is made regular (:mod:`skfem_pg.vc_boundary`):
+        How the singular system is made regular (:mod:`skfem_pg.discretization.vc_boundary`):
         ``"min-norm"`` (default: all constraints with FE-consistent
         :math:`A^i`, minimum-norm solution), or the thesis' variants
         ``"p"`` (V3/V5: correction fixed at ``d + 1`` anchor particles),
@@ -408,7 +408,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         ``area`` but keep their constraints
         (:meth:`~skfem_pg.Particles.surface_area_vectors`); under ``sn``
         the surface particles on the interface's edge are fixed fully, as
-        under ``s`` (:func:`~skfem_pg.vc_boundary.interface_edge`).
+        under ``s`` (:func:`~skfem_pg.discretization.vc_boundary.interface_edge`).
 
     index
         With list arguments: per group its family indices.
@@ -420,7 +420,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     """
     if variant not in ("V1", "V2", "V3", "V4", "V5"):
         raise ValueError("VC variant {!r} is not available (V1, V2, V3, "
-                         "V4, V5; second order: skfem_pg.vc2)"
+                         "V4, V5; second order: skfem_pg.discretization.vc2)"
                          .format(variant))
     if boundary not in BOUNDARY_VARIANTS:
         raise ValueError("VC boundary variant {!r} is not available: use "
@@ -609,7 +609,7 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
     accepts any residual with a warning (for studies of inexact
     corrections).
     """
-    from .errors import CorrectionError, describe_particle
+    from ..errors import CorrectionError, describe_particle
     if isinstance(G, (list, tuple)):  # per size group, fam the subsets
         Gl, fl = G, fam
     else:

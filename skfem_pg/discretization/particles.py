@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 import skfem as fem
 
-from .errors import ParticleError, UnsupportedMeshError, describe_particle
+from ..errors import ParticleError, UnsupportedMeshError, describe_particle
 
 # nodal (P1/Q1) and constant (P0) element of each supported linear mesh
 _LINEAR_ELEMENTS = {

@@ -30,12 +30,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import skfem as fem
 
-from .basis import FamilyBasis
-from .loads import traction as pg_traction
-from .materials import NeoHookeIsoVol
-from .mechanics import Hyperelastic, MeanDilatation
-from .particles import Particles
-from .solvers import newton
+from ..discretization.basis import FamilyBasis
+from ..discretization.loads import traction as pg_traction
+from ..materials import NeoHookeIsoVol
+from ..formulations import Hyperelastic, MeanDilatation
+from ..discretization.particles import Particles
+from ..solvers import newton
 
 #: method -> (mesh class needed, scalar element)
 FE_METHODS = {
@@ -215,7 +215,7 @@ class Scene:
               **basis_kwargs):
         """What :meth:`solve` hands Newton's method: ``(basis, model,
         f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`)."""
-        from .naming import fe_method, parse
+        from ..naming import fe_method, parse
         method = fe_method(scheme) or scheme
         t0 = time.perf_counter()
         if method not in FE_METHODS and method != "PG":

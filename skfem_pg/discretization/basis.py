@@ -17,7 +17,7 @@ Peridynamic Bubnov–Galerkin (PBG) method:
     \delta W = \sum_k \sum_{j\in H^k} w_{kj}\, P(F^{kj}) : \delta F^{kj},
     \qquad F^{kj} = I + \sum_i u^i\otimes G^{kji}.
 
-Petrov–Galerkin (``method="PPG1"``/``"PPG2"``, :mod:`skfem_pg.petrov`): the
+Petrov–Galerkin (``method="PPG1"``/``"PPG2"``, :mod:`skfem_pg.discretization.petrov`): the
 same elements with weights :math:`V^k` and a separate test basis
 ``basis.test`` (derivatives at the masters, VC-corrected); assemble with
 :func:`skfem_pg.assemble`, which picks ``basis.test`` up, or with
@@ -30,7 +30,7 @@ system.  ``G`` and ``dx`` are padded to the largest family size ``m``
 (padded slots have zero weight and zero gradient) for scikit-fem's generic
 assembly; the batched hot paths (:func:`skfem_pg.assemble`,
 ``interpolate``, the models) use the unpadded size groups of
-:mod:`skfem_pg.layout` instead.
+:mod:`skfem_pg.discretization.layout` instead.
 """
 import copy
 import sys
@@ -46,10 +46,11 @@ from . import families as families_mod
 from . import petrov
 from .corrections import (bond_correction, check_correction,
                           correction_functions, family_radii, vc_correction)
-from .errors import FamilyError, SlowAssemblyWarning, describe_particle
+from ..dofs import as_dofs
+from ..errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
 from .shape import GRADIENTS
-from .threads import kernel
+from ..threads import kernel
 from .shape.least_squares import (mls1_master_gradients,
                                    wls1_master_gradients,
                                    wls2_master_gradients)
@@ -84,7 +85,7 @@ class FamilyBasis(AbstractBasis):
         :class:`~skfem_pg.Particles`, or a scikit-fem mesh (its vertices
         become particles, :meth:`Particles.from_mesh`).
     families
-        :class:`~skfem_pg.families.Families`; default: mesh connectivity
+        :class:`~skfem_pg.discretization.families.Families`; default: mesh connectivity
         (``families.from_mesh``) for mesh particles, otherwise a horizon of
         1.51 h; for WTE2 a horizon of 2.51 h, small families enlarged to
         one member more than the quadratic basis needs.
@@ -99,7 +100,7 @@ class FamilyBasis(AbstractBasis):
         VC PPG1 without it has negative eigenvalues on the free block,
         ``tests/test_eigen.py``), off for WTE1.
     vc
-        Variationally consistent correction (:func:`~skfem_pg.corrections.
+        Variationally consistent correction (:func:`~skfem_pg.discretization.corrections.
         correction_functions`): ``"V5"`` (default with bond correction),
         ``"V3"`` (default for MTE1 without bond correction, for WTE2 and
         for PPG, whose test derivatives it corrects), ``"V4"`` (keeps
@@ -110,7 +111,7 @@ class FamilyBasis(AbstractBasis):
         ``"VC2"`` (second-order VC for ``shape="WTE2"``: PBG with V4
         correction functions, PPG1 (5.24) with V1 ones on its test
         derivatives; passes the quadratic patch test;
-        :mod:`skfem_pg.vc2`).
+        :mod:`skfem_pg.discretization.vc2`).
     method
         ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
         ``"PPG1"`` or ``"PPG2"`` (Peridynamic Petrov–Galerkin (4.21),
@@ -139,18 +140,18 @@ class FamilyBasis(AbstractBasis):
         quadratic patch test.  Uses the LSQR solve.
     vc_boundary
         Boundary conditions of the (singular) first-order VC system,
-        :mod:`skfem_pg.vc_boundary`: ``"min-norm"`` (default; every
+        :mod:`skfem_pg.discretization.vc_boundary`: ``"min-norm"`` (default; every
         constraint with FE-consistent :math:`A^i`), or the thesis' ``"p"``,
         ``"s"``, ``"sn"``.  With ``"s"``/``"sn"`` the surface particles'
         discrete area vectors (4.35) differ from FE's by
         ``basis.area_correction``, which the loads of
-        :mod:`skfem_pg.loads` include.
+        :mod:`skfem_pg.discretization.loads` include.
 
     vc_tolerance
         Largest accepted constraint residual after the VC correction,
         relative to :math:`h^{d-1}` (default 1e-8: the patch test holds
         to about 1e-10).  Above it, and for non-finite or blown-up
-        derivatives (:data:`~skfem_pg.corrections.GRADIENT_LIMIT`), the
+        derivatives (:data:`~skfem_pg.discretization.corrections.GRADIENT_LIMIT`), the
         basis raises :class:`~skfem_pg.errors.CorrectionError` naming the
         worst particles.  ``None`` keeps an inexact correction with a
         warning (studies of the incompatible V2/V4/VC2 systems).
@@ -161,7 +162,7 @@ class FamilyBasis(AbstractBasis):
         (linear least squares with a constant term), ``"WLS2"`` (its
         quadratic version), ``"MLS1"`` (moving least squares: weights and
         moment matrix differentiated too) or ``"LME"`` (local
-        maximum entropy, :mod:`skfem_pg.shape.lme`, locality ``lme_mu``;
+        maximum entropy, :mod:`skfem_pg.discretization.shape.lme`, locality ``lme_mu``;
         surface masters, where LME degenerates, keep ``"master"``).
 
     Attributes
@@ -172,10 +173,10 @@ class FamilyBasis(AbstractBasis):
         ``(nf, m)`` weights :math:`w_{kj}` (PPG: :math:`V^j`).
     test
         PPG only: the test basis (same families, dofs and weights, test
-        derivatives of :func:`skfem_pg.petrov.element_test_gradients`); ``None``
+        derivatives of :func:`skfem_pg.discretization.petrov.element_test_gradients`); ``None``
         for PBG.
     vc_report
-        :class:`~skfem_pg.corrections.VCReport` (``None`` without VC).
+        :class:`~skfem_pg.discretization.corrections.VCReport` (``None`` without VC).
     area_correction
         ``(dim, np)`` discrete minus FE-consistent surface area vectors
         (``vc_boundary`` ``"s"``/``"sn"``), else ``None``.
@@ -406,7 +407,7 @@ class FamilyBasis(AbstractBasis):
         """A basis from a thesis name (Table 7.1), e.g.
         ``FamilyBasis.from_name(p, "VCBCPBG V5 Unl", dim=2)``; see
         :mod:`skfem_pg.naming`."""
-        from .naming import parse
+        from ..naming import parse
         kw, notes = parse(name)
         basis = cls(particles, families, **{**kw, **kwargs})
         basis.name_notes = notes
@@ -415,7 +416,7 @@ class FamilyBasis(AbstractBasis):
     @property
     def name(self):
         """Thesis name, e.g. ``"VCBCPBG V5 Unl"``."""
-        from .naming import name_of
+        from ..naming import name_of
         return name_of(self)
 
     # ------------------------------------------------------------------
@@ -431,7 +432,7 @@ class FamilyBasis(AbstractBasis):
 
     def _unpadded_pipeline(self, vc_solver, area_vectors, vc_tolerance):
         """PBG with MTE1/WTE1 derivatives, bond and V3/V5 correction, one
-        size group at a time (:mod:`skfem_pg.layout`): work and storage
+        size group at a time (:mod:`skfem_pg.discretization.layout`): work and storage
         :math:`\\propto \\sum_k m_k^2` instead of :math:`n_f m_{max}^2`;
         the kernels are the padded ones, run on each group's own
         families."""
@@ -535,7 +536,7 @@ class FamilyBasis(AbstractBasis):
 
     @property
     def layout(self):
-        """:class:`~skfem_pg.layout.SizeGroups` of the families: the
+        """:class:`~skfem_pg.discretization.layout.SizeGroups` of the families: the
         unpadded layout of the hot paths."""
         return self.families.groups()
 
@@ -582,7 +583,7 @@ class FamilyBasis(AbstractBasis):
 
         Padded trailing axes ``(nf, m_max)`` (what scikit-fem's generic
         assembly needs; zero in padded slots), or with ``flat=True`` the
-        unpadded ``(1, N_q)`` of :mod:`skfem_pg.layout`, which
+        unpadded ``(1, N_q)`` of :mod:`skfem_pg.discretization.layout`, which
         :func:`skfem_pg.assemble` accepts too and which material models
         evaluate without the padding.
         """
@@ -621,7 +622,7 @@ class FamilyBasis(AbstractBasis):
             raise NotImplementedError(
                 "{} needs particles collocated from a mesh's vertices; for "
                 "{} particles use the particle values directly (u[basis."
-                "nodal_dofs]) or skfem_pg.postprocess.particle_fields"
+                "nodal_dofs]) or skfem_pg.analysis.postprocess.particle_fields"
                 .format(what, self.particles.kind))
         return fem.Basis(self.mesh, self.elem)
 
@@ -645,7 +646,7 @@ class FamilyBasis(AbstractBasis):
         :math:`\sum_k w_{ki} f(X^i) / m_i = f(X^i)` *is* the nodal
         interpolation.  Quadrature-point
         fields (``DiscreteField``) are not accepted: average them with
-        :func:`skfem_pg.postprocess.particle_fields` instead."""
+        :func:`skfem_pg.analysis.postprocess.particle_fields` instead."""
         if kwargs:
             raise TypeError("FamilyBasis.project takes no options ({})"
                             .format(", ".join(kwargs)))
@@ -663,7 +664,7 @@ class FamilyBasis(AbstractBasis):
             raise NotImplementedError(
                 "FamilyBasis.project takes a callable of x or a dof vector "
                 "of length {}; quadrature-point data: use "
-                "skfem_pg.postprocess.particle_fields".format(self.N))
+                "skfem_pg.analysis.postprocess.particle_fields".format(self.N))
         return v.astype(float).copy()
 
     def plot(self, z, **kwargs):
@@ -725,7 +726,6 @@ class FamilyBasis(AbstractBasis):
         if callable(nodes):
             nodes = np.nonzero(nodes(self.particles.x))[0]
         nc = 1 if self.ncomp is None else self.ncomp
-        from .solvers import as_dofs
         nodes = as_dofs(nodes, self.particles.n,
                         "particle indices (get_dofs nodes=)")
         return (nc * nodes[:, None] + np.arange(nc)).ravel()

@@ -4,7 +4,7 @@ A family is an ordered list of particle indices, **master first**
 (formulas.md section 1).  :class:`Families` stores them ragged (CSR-like
 ``offsets``/``members``) and hands out a padded ``(nf, m)`` view with a mask
 for the batched shape-function kernels and the unpadded size groups of
-:mod:`skfem_pg.layout` for the hot paths.
+:mod:`skfem_pg.discretization.layout` for the hot paths.
 
 Builders
 --------
@@ -26,7 +26,7 @@ requires ``dim + 1`` non-master members in general position.
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from .errors import FamilyError, describe_particle
+from ..errors import FamilyError, describe_particle
 
 
 class Families:
@@ -89,7 +89,7 @@ class Families:
         return self._padded
 
     def groups(self):
-        """The unpadded layout: :class:`~skfem_pg.layout.SizeGroups` of
+        """The unpadded layout: :class:`~skfem_pg.discretization.layout.SizeGroups` of
         the families (cached)."""
         if self._groups is None:
             from .layout import SizeGroups

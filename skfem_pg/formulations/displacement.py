@@ -1,4 +1,5 @@
-r"""Nonlinear solid models that Newton's method drives.
+r"""The displacement formulation (U1, Unl, U2 and FE): hyperelasticity on any
+vector basis, the model Newton's method drives.
 
 A model knows how to evaluate, for a displacement vector ``u``,
 
@@ -12,27 +13,14 @@ A model knows how to evaluate, for a displacement vector ``u``,
     Displacement formulation on any vector basis — scikit-fem FE (T1, Q1,
     O1, H1) or a :class:`~skfem_pg.FamilyBasis` (PBG).  Tangent consistent
     or, for family bases, by finite differences of the family forces.
-:class:`MeanDilatation`
-    Q1P0 / H1P0 (Simo–Taylor–Pister mean dilatation) for the iso/vol split
-    neo-Hooke (2.43): per element a constant dilatation
-    :math:`\Theta_e = \frac1{V_e}\int_e J` and pressure
-    :math:`p_e = U'(\Theta_e)`, condensed,
-
-    .. math:: \Pi = \sum_e \int_e W_{iso}(F) + V_e U(\Theta_e),\qquad
-              U(\Theta) = \tfrac K4(\Theta^2 - 1 - 2\ln\Theta).
-
-    Its tangent has a rank-one term per element,
-    :math:`\frac{U''(\Theta_e)}{V_e}\, g_e\otimes g_e` with
-    :math:`g_e = \int_e J F^{-T}:\nabla\varphi`.
+Q1P0 / H1P0: :mod:`skfem_pg.formulations.fe`.
 """
 import numpy as np
-import scipy.sparse as sp
 import skfem as fem
 from skfem.helpers import ddot, grad
 
-from .assembly import assemble
-from .threads import kernel
-from .materials import NeoHookeIsoVol, inverse_and_det
+from ..discretization.assembly import assemble
+from ..threads import kernel
 from .tangents import fd_tangent
 
 
@@ -95,7 +83,7 @@ class Hyperelastic:
     @kernel
     def state(self, u):
         """``{"F": ...}`` at the quadrature points: for a family basis in
-        the unpadded flat layout ``(d, d, 1, N_q)`` (:mod:`skfem_pg.layout`),
+        the unpadded flat layout ``(d, d, 1, N_q)`` (:mod:`skfem_pg.discretization.layout`),
         so the material is evaluated only at real members."""
         if hasattr(self.basis, "layout"):
             return {"F": self.basis.interpolate(u, flat=True).grad
@@ -125,58 +113,3 @@ class Hyperelastic:
             return fd_tangent(self.basis, self.material, state["F"])
         return assemble(material_tangent, self.basis,
                         A=self.material.tangent(state["F"]))
-
-
-class MeanDilatation(Hyperelastic):
-    """Q1P0 / H1P0 mean dilatation on a scikit-fem vector basis (see the
-    module docstring) for the iso/vol neo-Hooke with shear modulus ``mu``
-    and bulk modulus ``K``."""
-
-    def __init__(self, basis, mu, K):
-        if hasattr(basis, "G"):
-            raise ValueError("MeanDilatation is the FE comparator; for "
-                             "particles use the UnlP0 formulation")
-        super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(K)
-        self.material_full = NeoHookeIsoVol(mu, K)
-        self._V = basis.dx.sum(axis=1)
-
-    @kernel
-    def state(self, u):
-        s = super().state(u)
-        J = _det(s["F"])
-        s["J"] = J
-        s["Theta"] = (J * self.basis.dx).sum(axis=1) / self._V
-        return s
-
-    def _pressure(self, Theta):
-        return 0.5 * self.K * (Theta - 1.0 / Theta)
-
-    @kernel
-    def stress(self, state):
-        F, J = state["F"], state["J"]
-        FinvT = np.swapaxes(inverse_and_det(F)[0], 0, 1)
-        p = self._pressure(state["Theta"])[:, None]
-        return self.material.stress(F) + p * J * FinvT
-
-    @kernel
-    def tangent(self, state):
-        F, J, Theta = state["F"], state["J"], state["Theta"]
-        Finv = inverse_and_det(F)[0]
-        FinvT = np.swapaxes(Finv, 0, 1)
-        p = self._pressure(Theta)[:, None]
-        # d(J F^-T)/dF = J (F^-T (x) F^-T - F^-1_Jk F^-1_Li)
-        dJFinvT = J * (FinvT[:, :, None, None] * FinvT[None, None]
-                       - np.einsum("Jk...,Li...->iJkL...", Finv, Finv))
-        A = self.material.tangent(F) + p * dJFinvT
-        K = assemble(material_tangent, self.basis, A=A)
-        # rank-one volumetric term per element
-        g = internal_force.elemental(self.basis, P=J * FinvT).tolocal()
-        Upp = 0.5 * self.K * (1.0 + 1.0 / Theta ** 2)
-        loc = (Upp / self._V)[:, None, None] * g[:, :, None] * g[:, None, :]
-        ed = self.basis.element_dofs  # (Nbfun, nel)
-        rows = np.broadcast_to(ed.T[:, :, None], loc.shape)
-        cols = np.broadcast_to(ed.T[:, None, :], loc.shape)
-        Kvol = sp.coo_matrix((loc.ravel(), (rows.ravel(), cols.ravel())),
-                             shape=K.shape).tocsr()
-        return K + Kvol

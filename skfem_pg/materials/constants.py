@@ -1,10 +1,5 @@
-"""Forms for linear elasticity that assemble on FE and family bases alike.
-
-Plain scikit-fem forms (``skfem.helpers``), dimension agnostic.
-"""
+"""Elastic constants: checks and conversions."""
 import numpy as np
-import skfem as fem
-from skfem.helpers import ddot, sym_grad, trace, eye
 
 
 def check_moduli(**moduli):
@@ -62,16 +57,3 @@ def lame(E, nu, plane_stress=False):
     if plane_stress:
         lam = 2 * lam * mu / (lam + 2 * mu)
     return lam, mu
-
-
-def linear_elasticity(lam, mu):
-    r""":math:`a(u, v) = \int (2\mu\,\varepsilon(u) + \lambda\,\mathrm{tr}
-    \varepsilon(u) I) : \varepsilon(v)`."""
-    lam, mu = check_moduli(lam=lam, mu=mu)
-
-    @fem.BilinearForm
-    def linear_elasticity(u, v, w):
-        e = sym_grad(u)
-        return ddot(2.0 * mu * e + lam * eye(trace(e), e.shape[0]),
-                    sym_grad(v))
-    return linear_elasticity

@@ -15,7 +15,7 @@ into the sparse pattern like any other family matrix.
 """
 import numpy as np
 
-from .assembly import assemble_local
+from ..discretization.assembly import assemble_local
 
 
 def local_internal_forces(G, dx, P):

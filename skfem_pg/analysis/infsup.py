@@ -28,7 +28,7 @@ import scipy.sparse as sp
 import skfem as fem
 from skfem.helpers import ddot, div, grad
 
-from .assembly import assemble
+from ..discretization.assembly import assemble
 
 
 @fem.BilinearForm

@@ -18,7 +18,7 @@ import zipfile
 import numpy as np
 import skfem as fem
 
-from .scenes import FE_METHODS, centroid_tree, inside
+from .scene import FE_METHODS, centroid_tree, inside
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 

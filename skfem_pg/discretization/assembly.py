@@ -24,7 +24,7 @@ scalars).  The local matrices
 shape ``(ne, nq, c(d+1), c(d+1))``, or as a pair ``(C, channels)`` with
 ``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed)
 are batched matrix products, one batch per block of equal local size (for
-family bases the size groups of :mod:`skfem_pg.layout`: no padding),
+family bases the size groups of :mod:`skfem_pg.discretization.layout`: no padding),
 scattered into a block sparsity pattern that is computed once per basis.
 For a family basis ``k`` is a family, ``j`` a member (quadrature point)
 and ``i`` a member (basis function) with :math:`N^{kji} = \delta_{ij}`;
@@ -42,7 +42,7 @@ from skfem.element import DiscreteField, ElementVector
 
 from .basis import FamilyBasis
 from .shape.common import chunks
-from .threads import kernel
+from ..threads import kernel
 
 
 class _Block:
@@ -63,7 +63,7 @@ class _Block:
 
 class _FamilyView:
     """Local arrays of a :class:`FamilyBasis`, one block per family size
-    (:mod:`skfem_pg.layout`): no padding."""
+    (:mod:`skfem_pg.discretization.layout`): no padding."""
 
     def __init__(self, basis):
         self.basis = basis
@@ -157,7 +157,7 @@ def supports(basis):
 
 def _generic(form, *bases, **kwargs):
     """scikit-fem's own ``assemble`` of the form's scikit-fem class (also
-    for the subclasses of :mod:`skfem_pg.forms`, without recursion)."""
+    for the subclasses of :mod:`skfem_pg.discretization.forms`, without recursion)."""
     for cls in (BilinearForm, LinearForm, fem.Functional):
         if isinstance(form, cls):
             return cls.assemble(form, *bases, **kwargs)
@@ -367,7 +367,7 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     ``local_matrices(b, block, sl)`` returns, for the elements ``sl`` of
     block ``b`` (``block.conn``: their nodes; a :class:`FamilyBasis` has a
     block per family size, ``block.G`` its unpadded derivatives and
-    ``block.group`` its :class:`~skfem_pg.layout.Group`), an array of
+    ``block.group`` its :class:`~skfem_pg.discretization.layout.Group`), an array of
     shape ``(ne, m, m, c, c)``: entry ``[k, l, i]`` couples row node
     ``l`` (test) with column node ``i`` (trial), components
     ``[c_l, c_i]``.  With ``transposed=True`` it returns the

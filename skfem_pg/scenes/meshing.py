@@ -2,7 +2,7 @@
 gmsh geometries.
 
 gmsh is used through its Python API; ``.geo`` sources ship as package data
-in ``skfem_pg/meshes/`` (:func:`geo_path`).
+in ``skfem_pg/scenes/meshes/`` (:func:`geo_path`).
 """
 import os
 import tempfile
@@ -219,7 +219,7 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
 
 def geo_path(name):
     """Path of a ``.geo`` file shipped with the package
-    (``skfem_pg/meshes/``: cook.geo, cook3d.geo, cube.geo, square.geo)."""
+    (``skfem_pg/scenes/meshes/``: cook.geo, cook3d.geo, cube.geo, square.geo)."""
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "meshes")
     fn = os.path.join(here, name)
     if not os.path.isfile(fn):

@@ -13,7 +13,7 @@ Tangents are verified against central finite differences in
 """
 import numpy as np
 
-from .models import check_moduli
+from .constants import check_moduli
 
 
 def inverse_and_det(F):

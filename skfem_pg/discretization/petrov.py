@@ -28,7 +28,7 @@ Integration constraint of PPG1 (5.16): for every particle ``i``
 .. math:: \sum_{j\in H^i} V^j G_t^{jji} = A^i ,
 
 the PBG constraint with the weights :math:`w_{kj}` of the master only, so
-the VC correction of :mod:`~skfem_pg.corrections` (V3, one
+the VC correction of :mod:`~skfem_pg.discretization.corrections` (V3, one
 :math:`\alpha^k` per family) applies unchanged.  PPG matrices are not
 symmetric.
 """
@@ -81,7 +81,7 @@ def reverse_slots(fam):
         raise ValueError(
             "families are not pairwise: particle {} is in the family of "
             "particle {} but not the other way round; complete them with "
-            "skfem_pg.petrov.pairwise".format(mem[f, q], fam.masters[f]))
+            "skfem_pg.discretization.petrov.pairwise".format(mem[f, q], fam.masters[f]))
     return rev
 
 

@@ -44,7 +44,7 @@ def update_results(path, section, text):
     the path written, or ``None`` (with a printed note) if it cannot be
     written — e.g. an installed copy without the source tree."""
     import datetime
-    from . import threads
+    from .. import threads
     begin, end = ("<!-- begin {} -->".format(section),
                   "<!-- end {} -->".format(section))
     stamp = "*{}; {}.*".format(datetime.date.today().isoformat(),

@@ -9,7 +9,7 @@ moment matrices well conditioned and the singularity test scale invariant.
 """
 import numpy as np
 
-from ..errors import FamilyError, describe_particle
+from ...errors import FamilyError, describe_particle
 
 #: a normalised moment matrix with determinant below this is singular
 SINGULAR_TOL = 1e-10

@@ -2,7 +2,7 @@ r"""Boundary conditions of the VC correction system, thesis section 5.3
 (Table 7.1: ``p``, ``s``, ``sn``).
 
 The constraint system ``A α = b`` of a first-order VC correction
-(:func:`~skfem_pg.corrections.vc_correction`: rows = the integration
+(:func:`~skfem_pg.discretization.corrections.vc_correction`: rows = the integration
 constraints (5.18) of the particles, ``d`` each; columns = the correction
 factors :math:`\alpha^k` of the families, ``d`` each) is singular: the
 consistency modes it preserves are zero eigenvalues (``d + d²`` for V3/V5).
@@ -26,8 +26,8 @@ The thesis removes them with boundary conditions on the correction factors:
 With ``s`` and ``sn`` the system is square, ``d·n_int + (d−1)·n_surf``
 (``sn``) or ``d·n_int`` (``s``) equations in as many unknowns, and solved by
 one sparse LU.  Neumann loads must then use the discrete surface vectors
-(thesis (4.32)–(4.35)); :func:`skfem_pg.loads.stress_load` and
-:func:`~skfem_pg.loads.traction` do so through ``basis.area_correction``.
+(thesis (4.32)–(4.35)); :func:`skfem_pg.discretization.loads.stress_load` and
+:func:`~skfem_pg.discretization.loads.traction` do so through ``basis.area_correction``.
 The package's default (``"min-norm"``) imposes every constraint with the
 FE-consistent :math:`A^i` and takes the minimum-norm solution instead.
 

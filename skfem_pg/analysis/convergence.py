@@ -19,12 +19,12 @@ import time
 import numpy as np
 import skfem as fem
 
-from .analysis import h1_error
-from .assembly import assemble
-from .basis import FamilyBasis
-from .loads import body_force
-from .models import linear_elasticity
-from .particles import Particles, linear_elements
+from .verification import h1_error
+from ..discretization.assembly import assemble
+from ..discretization.basis import FamilyBasis
+from ..discretization.loads import body_force
+from ..formulations.linear import linear_elasticity
+from ..discretization.particles import Particles, linear_elements
 
 
 class PlaneWaves:

@@ -80,7 +80,7 @@ class SizeGroups:
 
     def subset(self, group):
         """The families of ``group`` as a
-        :class:`~skfem_pg.families.Families` of their own (no padding: the
+        :class:`~skfem_pg.discretization.families.Families` of their own (no padding: the
         batched kernels run on it unchanged)."""
         from .families import Families
         nf, m = group.members.shape

@@ -1,0 +1,29 @@
+"""The discretization: mesh → particles → families → shape-function
+derivatives → corrections → :class:`FamilyBasis`, and the batched assembly
+that turns scikit-fem forms on it (and on FE cell bases) into sparse
+systems.
+
+=====================  ====================================================
+``particles``          particles collocated from meshes (volumes, area
+                       vectors, fold and inversion checks)
+``families``           family builders (mesh connectivity, horizons)
+``shape``              WTE1/MTE1, WTE2, least-squares and LME derivatives
+``corrections``        bond (5.55) and VC (5.57)–(5.64) corrections;
+                       ``vc_boundary``, ``vc2``: boundary variants, VC2
+``petrov``             PPG test bases (4.21), (4.22)
+``layout``             families grouped by size (unpadded hot paths)
+``basis``              :class:`FamilyBasis`
+``assembly``, ``forms``  batched assembly; the fast-path decorators
+``loads``              tractions, stress and body loads on FE and PG bases
+=====================  ====================================================
+"""
+from .particles import Particles
+from .families import Families
+from .basis import FamilyBasis
+from .assembly import assemble, block_pattern
+from .forms import BilinearForm, LinearForm
+from .loads import traction, stress_load, body_force
+
+__all__ = ["Particles", "Families", "FamilyBasis", "assemble",
+           "block_pattern", "BilinearForm", "LinearForm", "traction",
+           "stress_load", "body_force"]

@@ -1,0 +1,195 @@
+r"""Newton's method with adaptive load stepping.
+
+Newton drives a model of :mod:`skfem_pg.formulations`: residual
+:math:`r(u) = f_{int}(u) - \lambda f_{ext}`, tangent
+:math:`\partial f_{int}/\partial u`.
+
+Load stepping: the load factor :math:`\lambda` goes from 0 to 1 (external
+forces and prescribed displacements are scaled).  A step is cut in half when
+Newton diverges, exceeds ``maxiter`` or meets :math:`J \le 0` anywhere; a
+:class:`ConvergenceError` names the load factor once the step would fall
+below ``min_step``.
+"""
+import time
+
+import numpy as np
+
+from ..dofs import as_dofs, check_vector as _vector
+from .linear import linear_solver
+
+
+class ConvergenceError(RuntimeError):
+    """Newton's method could not reach the requested load.
+
+    ``load``, ``u`` and ``history`` hold the last converged state, so a
+    caller can report how far the loading got."""
+
+    def __init__(self, message, load=0.0, u=None, history=None):
+        super().__init__(message)
+        self.load, self.u, self.history = load, u, history or []
+
+
+#: extra smoothed random near-null-space candidates of the AMG hierarchy
+#: for family bases (:class:`AMGSolver`).  12 is the measured compromise:
+#: 18 needs the fewest iterations but the longest setup, which Newton's
+#: rebuilds (after load steps and fallbacks) pay again; 3-D Cook, 4,038
+#: nodes, PG seconds per Newton iteration with 6 / 12 / 18: 6.63 / 6.50 /
+#: 7.57 (Krylov its 48 / 37 / 34); one linear solve, 59k unknowns, setup +
+#: solve about 61 / 41 / 54 s (benchmarks/README.md)
+PG_CANDIDATES = 12
+
+
+def _condensed_solver(kind, basis, I):
+    locs = getattr(basis, "doflocs", None)
+    return linear_solver(kind, None if locs is None else locs[:, I],
+                         symmetric=getattr(basis, "test", None) is None,
+                         candidates=PG_CANDIDATES if hasattr(basis, "layout")
+                         else 0)
+
+
+def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
+           tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
+           predictor=True, verbose=True):
+    r"""Solve :math:`f_{int}(u) = \lambda f_{ext}` up to :math:`\lambda = 1`
+    with adaptive load steps.
+
+    Parameters
+    ----------
+    model
+        A :mod:`skfem_pg.formulations` model, e.g.
+        ``Hyperelastic(basis, NeoHooke(lam, mu))``.
+    f_ext
+        External force vector at load factor 1 (default 0).
+    D, u_D
+        Prescribed dofs and their values at load factor 1 (full-length
+        vector; default 0).
+    steps
+        Initial number of load steps (the step then adapts).
+    tol
+        Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
+        ``r_0`` is the first residual of the step, or a Newton increment
+        below ``1e-10 |u|`` (the round-off floor of ill-conditioned, e.g.
+        nearly incompressible, problems).
+    solver
+        Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``
+        (:func:`linear_solver` on the free dofs), or a callable ``(A, b)
+        -> x`` for the condensed systems, e.g. a :func:`linear_solver`
+        built once and shared by several calls.
+    predictor
+        Start each load step from the linear extrapolation of the last two
+        converged states (secant predictor) instead of the last one; a
+        step that fails from it is cut like any other.
+
+    Returns
+    -------
+    u, history
+        ``history`` is a list of dicts per converged step (load factor,
+        residual norms per iteration, minimum J, seconds).
+
+    """
+    basis = model.basis
+    N = basis.N
+    Dd = as_dofs(D, N)
+    I = np.setdiff1d(np.arange(N), Dd)
+    f_ext = np.zeros(N) if f_ext is None else _vector(f_ext, N, "f_ext")
+    u_D = np.zeros(N) if u_D is None else _vector(u_D, N, "u_D")
+    u = np.zeros(N) if u0 is None else _vector(u0, N, "u0").copy()
+    lin = solver if callable(solver) else _condensed_solver(solver, basis, I)
+    stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
+    lam, dlam = 0.0, 1.0 / steps
+    prev = None  # (load, u) of the converged step before the last
+    history = []
+    while lam < 1.0 - 1e-14:
+        target = min(1.0, lam + dlam)
+        t0 = time.perf_counter()
+        start = u
+        if predictor and prev is not None:
+            start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
+        n_krylov = len(stats["iterations"])
+        ok, uk, info = _newton_step(model, start, target, f_ext, Dd, u_D, I,
+                                    lin, tol, maxiter)
+        info.update(load=target, seconds=time.perf_counter() - t0,
+                    krylov=stats["iterations"][n_krylov:])
+        if verbose:
+            print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
+                  "min J {:.3g}".format(
+                      target, target - lam,
+                      "converged" if ok else "FAILED ({})".format(
+                          info["reason"]),
+                      len(info["residuals"]) - 1,
+                      " ".join("{:.1e}".format(r)
+                               for r in info["residuals"]),
+                      info["min_J"]), flush=True)
+        if ok:
+            prev = (lam, u)
+            u, lam = uk, target
+            history.append(info)
+            if len(info["residuals"]) <= 5:
+                dlam = min(2 * dlam, 1.0)
+            continue
+        dlam /= 2
+        if dlam < min_step:
+            raise ConvergenceError(
+                "Newton failed at load factor {:.6g} ({}); the step fell "
+                "below min_step = {:.3g} after reaching load {:.6g}".format(
+                    target, info["reason"], min_step, lam),
+                load=lam, u=u, history=history)
+    return u, history
+
+
+def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
+    """Newton iterations at load factor ``lam`` from the converged ``u``.
+
+    The increment of the prescribed displacements enters the first linear
+    solve (``K_II du_I = -r_I - K_ID du_D``), so it is spread through the
+    body instead of distorting the boundary layer.
+    """
+    u = u.copy()
+    du_D = lam * u_D[Dd] - u[Dd]
+    pending = bool(np.any(du_D != 0))
+    res = []
+    info = {"residuals": res, "min_J": np.nan, "reason": "",
+            "t_assemble": 0.0, "t_linear": 0.0}
+    ref = None
+    du_norm = np.inf
+    for it in range(maxiter + 1):
+        t0 = time.perf_counter()
+        state = model.state(u)
+        info["min_J"] = model.min_J(state)
+        if not info["min_J"] > 0:
+            info["reason"] = "J <= 0"
+            return False, u, info
+        r = model.internal_force(state) - lam * f_ext
+        info["t_assemble"] += time.perf_counter() - t0
+        rn = float(np.linalg.norm(r[I]))
+        res.append(rn)
+        if not np.isfinite(rn):
+            info["reason"] = "non-finite residual"
+            return False, u, info
+        if not pending:
+            if ref is None:
+                ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
+            if rn <= tol * ref or du_norm <= 1e-10 * np.abs(u).max():
+                return True, u, info
+            if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
+                info["reason"] = "diverging"
+                return False, u, info
+        if it == maxiter:
+            info["reason"] = "maxiter"
+            return False, u, info
+        t0 = time.perf_counter()
+        K = model.tangent(state).tocsr()
+        t1 = time.perf_counter()
+        du = np.zeros_like(u)
+        rhs = -r[I]
+        if pending:
+            du[Dd] = du_D
+            rhs = rhs - K[I][:, Dd] @ du_D
+        du[I] = lin(K[I][:, I].tocsr(), rhs)
+        info["t_assemble"] += t1 - t0
+        info["t_linear"] += time.perf_counter() - t1
+        du_norm = np.abs(du).max()
+        u += du
+        pending = False
+    info["reason"] = "maxiter"
+    return False, u, info
