@@ -1,4 +1,4 @@
-"""Checks of dof indices and dof vectors against a system size."""
+"""Checks of dof indices against a system size."""
 import numpy as np
 
 
@@ -29,11 +29,3 @@ def as_dofs(D, N, what="Dirichlet dofs"):
                          "indices are not accepted)".format(
                              what, N - 1, N, D[bad][:5]))
     return np.unique(D)
-
-
-def check_vector(v, N, what):
-    v = np.asarray(v, dtype=float).ravel() if v is not None else None
-    if v is not None and v.shape != (N,):
-        raise ValueError("{} must have one entry per dof ({}), got {}"
-                         .format(what, N, v.shape[0]))
-    return v

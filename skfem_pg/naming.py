@@ -18,6 +18,9 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
             Table 7.1.  ``m`` (a package extension) is the package's
             minimum-norm solve
 ``U1``      WTE1 (classical correspondence), ``Unl`` MTE1, ``U2`` WTE2
+``UnlP0``   mixed (thesis 6.2): ``UnlP0``, ``IUnlP0``, ``Unl+P1C`` on MTE1
+            displacements, ``U2P1``, ``U2P1C`` on WTE2; stabilized (6.3):
+            ``U1SUnl``, ``U1SIG`` on WTE1
 ``TL``      total Lagrangian reference frame (the default; ``UL``, updated
             Lagrange, is not built yet)
 ==========  ==============================================================
@@ -28,18 +31,25 @@ its own, measured defaults: the bond correction as there (on for MTE1) and
 the minimum-norm VC solve (``vc_boundary="min-norm"``), which passes the
 same patch tests and is less erratic than ``sn`` on 3-D tetrahedra
 (README); ``FamilyBasis.from_name(p, name, vc_boundary="min-norm")`` or
-the suffix ``m`` gets it for a thesis name.  The mixed and stabilized
-formulations (``UnlP0``, ``IUnlP0``, ``U2P1``, ``U2P1C``, ``Unl+P1C``,
-``U1SUnl``, ``U1SIG``) are recognised and raise ``NotImplementedError``.
+the suffix ``m`` gets it for a thesis name.
+
+Every formulation of Table 7.1 parses: :func:`parse` gives the options of
+its *displacement* basis (MTE1 for ``UnlP0``, WTE2 for ``U2P1``, ...) and
+:func:`formulation_of` the formulation token, which
+:func:`skfem_pg.formulations.by_name.model_for` turns into a model (and
+which raises ``NotImplementedError`` for the formulations not built yet).
 """
 import re
 
-SHAPES = {"U1": "WTE1", "Unl": "MTE1", "U2": "WTE2"}
+#: formulation -> shape functions of its displacement basis
+SHAPES = {"U1": "WTE1", "Unl": "MTE1", "U2": "WTE2",
+          "UnlP0": "MTE1", "IUnlP0": "MTE1", "Unl+P1C": "MTE1",
+          "U2P1": "WTE2", "U2P1C": "WTE2",
+          "U1SUnl": "WTE1", "U1SIG": "WTE1"}
+#: the displacement formulations (the rest are mixed or stabilized)
+DISPLACEMENT = ("U1", "Unl", "U2")
 #: first-order formulations: the bond correction is their default
-FIRST_ORDER = ("U1", "Unl")
-#: Table 7.1's formulations that are not built yet
-PLANNED = ("UnlP0", "IUnlP0", "U2P1", "U2P1C", "Unl+P1C", "U1SUnl",
-           "U1SIG")
+FIRST_ORDER = tuple(f for f, s in SHAPES.items() if s in ("WTE1", "MTE1"))
 FE_NAMES = ("T1", "Q1", "O1", "H1", "Q1P0", "H1P0", "T2", "Q2", "O2", "H2")
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
@@ -60,11 +70,22 @@ def fe_method(name):
     return parts[0] if len(parts) == 1 and parts[0] in FE_NAMES else None
 
 
+def formulation_of(name):
+    """The formulation token of a thesis name (``"UnlP0"`` for
+    ``"VCBCPBG V5sn UnlP0 TL"``); FE names give their method
+    (``"H1P0"`` for ``"FEM H1P0"``)."""
+    fe = fe_method(name)
+    if fe is not None:
+        return fe
+    parse(name)  # raises for what cannot be read
+    return _NAME.match(name.strip()).group("form")
+
+
 def parse(name):
-    """``(kwargs, notes)`` for :class:`~skfem_pg.FamilyBasis` from a
-    thesis name, with Table 7.1's defaults; raises ``ValueError`` naming
-    what is not understood and ``NotImplementedError`` for formulations
-    that are not built."""
+    """``(kwargs, notes)`` for the displacement
+    :class:`~skfem_pg.FamilyBasis` of a thesis name, with Table 7.1's
+    defaults; raises ``ValueError`` naming what is not understood and
+    ``NotImplementedError`` for options that are not built (UL)."""
     if fe_method(name) is not None:
         raise ValueError("{!r} is an FE comparator, not a family basis: "
                          "use Scene.solve({!r})".format(name, name))
@@ -75,14 +96,9 @@ def parse(name):
                          .format(name))
     g = m.groupdict()
     form = g["form"]
-    if form in PLANNED:
-        raise NotImplementedError(
-            "formulation {!r} ({}) is not built yet: this version has the "
-            "displacement formulations U1, Unl, U2".format(form, name))
     if form not in SHAPES:
-        raise ValueError("unknown formulation {!r} in {!r}: U1, Unl, U2 "
-                         "(Table 7.1 also lists {})".format(
-                             form, name, ", ".join(PLANNED)))
+        raise ValueError("unknown formulation {!r} in {!r}: one of {}"
+                         .format(form, name, ", ".join(SHAPES)))
     if g["frame"] == "UL":
         raise NotImplementedError("{!r}: the updated Lagrangian frame (UL) "
                                   "is not built yet; TL is".format(name))
@@ -90,7 +106,8 @@ def parse(name):
     first_order = form in FIRST_ORDER
     if g["bc"] and not first_order:
         raise ValueError("{!r}: the bond correction is for first-order "
-                         "formulations (U1, Unl), not {}".format(name, form))
+                         "formulations ({}), not {}".format(
+                             name, ", ".join(FIRST_ORDER), form))
     if g["bc"] and g["nobc"]:
         raise ValueError("{!r} asks for BC and noBC".format(name))
     kw = {"shape": SHAPES[form], "method": method,
@@ -129,7 +146,7 @@ def name_of(basis):
     ``"VCBCPBG V5m Unl TL"``: every option written, so that
     :func:`parse` gives the basis back."""
     vc = basis.vc
-    form = {v: k for k, v in SHAPES.items()}[basis.shape]
+    form = {SHAPES[f]: f for f in DISPLACEMENT}[basis.shape]
     first_order = form in FIRST_ORDER
     prefix = ("VC2" if vc == "VC2" else "VC" if vc else "") + \
         ("BC" if basis.bond else "")

@@ -65,9 +65,3 @@ def test_q1p0_reproduces_lame_cylinder_where_q1_locks():
         err[name] = abs(u[2 * node[0]] - exact) / exact
     assert err["Q1P0"] < 5e-3   # measured 1.9e-3 (rate 2 under refinement)
     assert err["Q1"] > 0.3      # volumetric locking: 45 % too stiff
-
-
-def test_mean_dilatation_refuses_family_bases():
-    b = pg.FamilyBasis(pg.Particles.from_mesh(annulus(2)), dim=2)
-    with pytest.raises(ValueError, match="UnlP0"):
-        MeanDilatation(b, 1.0, 10.0)

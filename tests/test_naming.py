@@ -3,7 +3,7 @@ defaults: BC for first-order formulations, boundary variant sn, TL."""
 import pytest
 
 import skfem_pg as pg
-from skfem_pg.naming import fe_method, parse
+from skfem_pg.naming import fe_method, formulation_of, parse
 from conftest import square
 
 
@@ -70,14 +70,12 @@ def test_fe_names():
 def test_bad_names_are_named():
     with pytest.raises(ValueError, match="cannot read"):
         parse("VCBC V5 Unl")
-    for name in ("VCPPG V3sn UnlP0", "PPG IUnlP0", "VCPBG U1SIG",
-                 "VCBCPBG V5sn Unl+P1C TL", "VCBCPBG UL Unl"):
-        with pytest.raises((NotImplementedError, ValueError)):
-            parse(name)
+    with pytest.raises(ValueError, match="cannot read"):
+        parse("VCBCPBG UL Unl")
+    with pytest.raises(ValueError, match="unknown formulation"):
+        parse("VCPBG UnlP1")
     with pytest.raises(NotImplementedError, match="UL"):
         parse("VCBCPBG V5sn Unl UL")
-    with pytest.raises(NotImplementedError, match="UnlP0"):
-        parse("VCPPG V3sn UnlP0")
     with pytest.raises(ValueError, match="variant"):
         parse("BCPBG V5sn Unl")
     with pytest.raises(ValueError, match="first-order"):
@@ -104,3 +102,40 @@ def test_scene_solves_by_thesis_and_fe_names():
     assert np.allclose(c.u, d.u, rtol=0, atol=1e-12)
     with pytest.raises(ValueError, match="unknown method"):
         s.solve("VCPBG")
+
+
+#: every formulation name the thesis text uses (thesis-remaining.md A8)
+THESIS_NAMES = [
+    "PPG Unl", "PBG Unl", "BCPBG Unl", "VCBCPBG Unl", "VCPBG Unl",
+    "VCPPG Unl", "VCPPG V1sn Unl", "VCPPG V2sn Unl", "VCPPG V3p Unl",
+    "VCPPG V3s Unl", "VCPPG V3sn Unl", "VCPBG V5sn Unl", "VCPBG U1",
+    "PBG U2", "VCPBG U2", "VC2PPG V1s U2", "PPG UnlP0", "PBG UnlP0",
+    "VCPBG UnlP0", "VCPPG UnlP0", "VCPPG V1sn UnlP0", "VCPPG V2sn UnlP0",
+    "VCPPG V3sn UnlP0", "PPG IUnlP0", "PBG U2P1", "VCPBG U2P1",
+    "PBG U2P1C", "VCPBG U2P1C", "PBG Unl+P1C", "VCPBG Unl+P1C",
+    "VCPBG U1SUnl", "PBG U1SIG", "VCPBG U1SIG", "VCBCPBG V5sn Unl+P1C TL"]
+
+
+@pytest.mark.parametrize("name", THESIS_NAMES)
+def test_every_thesis_name_parses(name):
+    """The displacement basis of each formulation, with Table 7.1's
+    defaults: BC for the first-order ones (U1, Unl and the mixed and
+    stabilized formulations built on them), none for U2-based ones."""
+    kw, _ = parse(name)
+    form = formulation_of(name)
+    assert name.split()[-1 if not name.endswith("TL") else -2] == form
+    shape = {"U1": "WTE1", "U1SUnl": "WTE1", "U1SIG": "WTE1",
+             "U2": "WTE2", "U2P1": "WTE2", "U2P1C": "WTE2"}.get(form, "MTE1")
+    assert kw["shape"] == shape
+    assert kw["bond"] == (shape != "WTE2")
+    assert kw["method"] == ("PBG" if "PBG" in name else "PPG1")
+    if name.startswith("VC"):
+        assert kw["vc_boundary"] in ("sn", "s", "p")
+
+
+def test_formulation_of():
+    assert formulation_of("VCBCPBG V5sn UnlP0 TL") == "UnlP0"
+    assert formulation_of("PPG IUnlP0") == "IUnlP0"
+    assert formulation_of("FEM H1P0") == "H1P0"
+    with pytest.raises(ValueError, match="cannot read"):
+        formulation_of("UnlP0")

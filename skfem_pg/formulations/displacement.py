@@ -1,19 +1,26 @@
 r"""The displacement formulation (U1, Unl, U2 and FE): hyperelasticity on any
-vector basis, the model Newton's method drives.
+vector basis, and the interface every formulation offers the solvers.
 
-A model knows how to evaluate, for a displacement vector ``u``,
+A *model* (this class, and those of :mod:`~skfem_pg.formulations.dilatation`
+and :mod:`~skfem_pg.formulations.incompressible`) owns its fields.  Its
+unknowns ``x`` (length ``model.N``) are the displacements in scikit-fem's
+numbering of ``model.basis`` — always first, ``model.n_u`` of them — followed
+by the global fields the formulation adds (e.g. one pressure per family for
+IUnlP0); local fields (a condensed pressure and dilatation per family) live
+in the state.  For ``x`` a model evaluates
 
-* ``state(u)``: the deformation gradient (and what else the model needs) at
-  the quadrature points,
-* ``internal_force(state)``: :math:`f_{int}`,
-* ``tangent(state)``: :math:`\partial f_{int}/\partial u`,
-* ``min_J(state)``: the smallest :math:`J = \det F` (inversion check).
+* ``state(x)``: deformation gradients and whatever else it needs at the
+  quadrature points,
+* ``internal_force(state)``: the residual :math:`\partial\Pi/\partial x`
+  without external loads (length ``N``),
+* ``tangent(state)``: :math:`\partial^2\Pi/\partial x^2` (sparse ``N × N``),
+* ``min_J(state)``: the smallest :math:`J = \det F` (inversion check),
+* ``fields(x)``: the extra fields by name (per element / family),
 
-:class:`Hyperelastic`
-    Displacement formulation on any vector basis — scikit-fem FE (T1, Q1,
-    O1, H1) or a :class:`~skfem_pg.FamilyBasis` (PBG).  Tangent consistent
-    or, for family bases, by finite differences of the family forces.
-Q1P0 / H1P0: :mod:`skfem_pg.formulations.fe`.
+and names its unknowns in ``blocks`` (``(name, slice)``), so that Newton's
+method measures convergence per field.  Loads, Dirichlet dofs and results
+address the displacements alone, in scikit-fem numbering, whatever extra
+fields exist.
 """
 import numpy as np
 import skfem as fem
@@ -75,10 +82,31 @@ class Hyperelastic:
         if tangent == "fd" and not hasattr(basis, "G"):
             raise ValueError("the finite-difference tangent is built from "
                              "family forces: it needs a FamilyBasis")
+        if not np.isfinite(getattr(material, "K", 0.0)):
+            raise ValueError(
+                "{!r} is incompressible (K = inf): a displacement "
+                "formulation cannot carry it; use the IUnlP0 formulation "
+                "(skfem_pg.formulations.IncompressibleP0)".format(material))
         self.basis, self.material, self.tangent_kind = basis, material, \
             tangent
+        self.n_u = basis.N
         d = _dim(basis)
         self._eye = np.eye(d).reshape(d, d, 1, 1)
+
+    @property
+    def N(self):
+        """Number of unknowns: displacements, then the model's global
+        fields."""
+        return self.n_u
+
+    @property
+    def blocks(self):
+        """``(name, slice)`` of each field in the unknowns."""
+        return [("u", slice(0, self.n_u))]
+
+    def fields(self, x):
+        """Extra fields of the solution ``x`` by name (none here)."""
+        return {}
 
     @kernel
     def state(self, u):

@@ -197,6 +197,15 @@ class NeoHookeIsoVol(Material):
         m.K = 0.0
         return m
 
+    @classmethod
+    def incompressible(cls, mu):
+        """The incompressible limit (:math:`\nu = 0.5`, ``K = inf``): only
+        the formulations with a pressure unknown (IUnlP0,
+        :class:`~skfem_pg.formulations.IncompressibleP0`) accept it."""
+        m = cls(mu, 1.0)
+        m.K = np.inf
+        return m
+
     def stress(self, F):
         Finv, J = inverse_and_det(F)
         FinvT = np.swapaxes(Finv, 0, 1)

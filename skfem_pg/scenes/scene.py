@@ -3,9 +3,12 @@ the same nodes with one call.
 
 A :class:`Scene` holds a mesh (the node set), a material, clamped and
 prescribed boundaries, dead-load tractions and probe points.
-``scene.solve("PG", **basis_kwargs)`` runs a :class:`~skfem_pg.FamilyBasis`
-(VC PBG Unl by default); ``scene.solve("Q1")`` etc. run scikit-fem elements
-on the same mesh:
+``scene.solve("VCBCPBG V5sn UnlP0")`` runs a formulation by its thesis name
+(Table 7.1, :mod:`skfem_pg.naming`) on a :class:`~skfem_pg.FamilyBasis`
+collocated from the mesh, ``scene.solve("PG", **basis_kwargs)`` the
+displacement formulation (VC PBG Unl by default) with basis options, and
+``scene.solve("FEM H1P0")`` (or ``"H1P0"``) scikit-fem elements on the same
+mesh:
 
 =======  =======================  =========================================
 method   mesh                     element
@@ -20,8 +23,15 @@ T2, Q2,  as above                 quadratic (for FE overkill references)
 O2, H2
 =======  =======================  =========================================
 
+Q1P0 / H1P0 with :meth:`NeoHookeIsoVol.incompressible
+<skfem_pg.materials.NeoHookeIsoVol.incompressible>` carry one pressure per
+element as an unknown (as PG IUnlP0 does per family).
+
 Every solve reports wall time split into preprocess (basis, families,
 corrections), assemble and linear solve (summed over Newton iterations).
+A :class:`Result` holds the displacements in scikit-fem numbering of its
+basis (``u``) whatever the formulation, its extra fields (``fields``) and
+the reaction forces (:meth:`Result.reaction`).
 """
 import hashlib
 import time
@@ -32,9 +42,8 @@ import skfem as fem
 
 from ..discretization.basis import FamilyBasis
 from ..discretization.loads import traction as pg_traction
-from ..materials import NeoHookeIsoVol
-from ..formulations import Hyperelastic, MeanDilatation
 from ..discretization.particles import Particles
+from ..formulations.by_name import model_for
 from ..solvers import newton
 
 #: method -> (mesh class needed, scalar element)
@@ -62,17 +71,46 @@ INTORDER = {"T1": 1, "O1": 1, "Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2,
 
 @dataclass
 class Result:
-    """A scene solution."""
+    """A scene solution.
+
+    ``u``: the displacements in scikit-fem numbering of ``basis`` (for
+    every formulation); ``fields``: the formulation's extra fields by name
+    (e.g. ``p`` and ``Theta`` per element or family for Q1P0 / UnlP0);
+    ``x``: all unknowns of ``model`` (``u`` first); ``f_ext``: the external
+    forces at the end of the load path."""
     method: str
     u: np.ndarray
     basis: object
     probes: dict
     times: dict
     history: list = field(default_factory=list)
+    fields: dict = field(default_factory=dict)
+    model: object = None
+    x: np.ndarray = None
+    f_ext: np.ndarray = None
 
     @property
     def total_time(self):
         return sum(self.times.values())
+
+    def residual(self):
+        """:math:`f_{int}(u) - f_{ext}` on the displacement dofs: zero
+        (to the solver's tolerance) where the displacements are free, the
+        reaction forces where they are prescribed."""
+        r = self.model.internal_force(self.model.state(self.x))
+        return r[:len(self.u)] - self.f_ext
+
+    def reaction(self, boundary):
+        """The total reaction force vector ``(d,)`` on the named
+        ``boundary`` (or facets): the sum, per component, of the residual
+        :meth:`residual` over the boundary's dofs (nodal and, for
+        quadratic elements, facet and edge dofs).  Meaningful on a
+        boundary whose displacements are prescribed."""
+        r = self.residual()
+        dofs = self.basis.get_dofs(boundary)
+        d = self.basis.mesh.dim()
+        return np.array([r[dofs.all("u^{}".format(c + 1))].sum()
+                         for c in range(d)])
 
 
 class Scene:
@@ -89,9 +127,18 @@ class Scene:
     clamped
         Boundary names with ``u = 0``.
     prescribed
-        ``{boundary: {component: value}}`` displacements at load factor 1.
+        ``{boundary: {component: value}}``: displacement components at
+        load factor 1 (scaled by the load factor), or ``{boundary: f}``
+        with ``f(x, t)`` the displacement ``(d, n)`` at reference
+        positions ``x`` ``(d, n)`` and load factor ``t`` (all components
+        prescribed; e.g. a rotation, which is not ``t`` times its end
+        value).  Evaluated at the dof locations: the nodes, and the facet
+        and edge dofs of quadratic elements.
     tractions
-        ``{boundary: vector}`` dead-load tractions at load factor 1.
+        ``{boundary: t}`` dead-load tractions at load factor 1: a vector,
+        or a callable of the facet quadrature points ``x`` ``(d, nfacets,
+        nqp)`` returning ``(d, nfacets, nqp)``, on FE and PG alike
+        (:func:`skfem_pg.traction`).
     probes
         ``{label: point}`` where displacements are reported.
     steps
@@ -127,13 +174,15 @@ class Scene:
                 return sorted((str(k), exact(a)) for k, a in v.items())
             if isinstance(v, (list, tuple)):
                 return [exact(a) for a in v]
+            if callable(v):
+                return _callable_key(v)
             return repr(v)
         material = (type(self.material).__module__,
                     type(self.material).__qualname__,
                     exact(vars(self.material)))
         return repr((self.name, material, exact(list(self.clamped)),
                      exact(self.prescribed),
-                     exact({k: np.asarray(v, float)
+                     exact({k: v if callable(v) else np.asarray(v, float)
                             for k, v in self.tractions.items()}),
                      exact(self.probes), exact(self.params)))
 
@@ -173,51 +222,86 @@ class Scene:
             method, need.__name__, type(mesh).__name__))
 
     def _dirichlet(self, basis):
-        D, u_D = [], np.zeros(basis.N)
+        """Prescribed dofs ``D`` and their values as a function of the
+        load factor, ``u_D(t)`` (a full-length vector)."""
+        D, const, moving = [], np.zeros(basis.N), []
         for name in self.clamped:
             D.append(basis.get_dofs(name).flatten())
-        for name, comps in self.prescribed.items():
+        d = self.dim
+        for name, how in self.prescribed.items():
             dofs = basis.get_dofs(name)
-            for c, val in comps.items():
-                # every dof of the component: nodal, and the facet/edge
-                # dofs of quadratic elements (a constant's interpolant)
-                idx = dofs.all("u^{}".format(c + 1))
-                D.append(idx)
-                u_D[idx] = val
+            # every dof of a component: nodal, and the facet/edge dofs of
+            # quadratic elements (a constant's or a function's interpolant)
+            idx = [dofs.all("u^{}".format(c + 1)) for c in range(d)]
+            if callable(how):
+                D.extend(idx)
+                moving.append((how, idx))
+                continue
+            for c, val in how.items():
+                D.append(idx[c])
+                const[idx[c]] = val
         D = np.unique(np.concatenate(D)) if D else np.zeros(0, int)
+        locs = basis.doflocs
+
+        def u_D(t):
+            u = t * const
+            for f, idx in moving:
+                for c in range(d):
+                    x = locs[:, idx[c]]
+                    val = np.asarray(f(x, t), dtype=float)
+                    if val.shape != x.shape:
+                        raise ValueError(
+                            "a prescribed displacement f(x, t) must return "
+                            "shape (dim, n) = {} for x of that shape, got {}"
+                            .format(x.shape, val.shape))
+                    u[idx[c]] = val[c]
+            return u
         return D, u_D
 
     def _fe_traction(self, basis, mesh, name, t):
         fb = fem.FacetBasis(mesh, basis.elem, facets=name)
-        t = np.asarray(t, float)
-        return fem.LinearForm(
-            lambda v, w: sum(t[a] * v[a] for a in range(len(t)))
-        ).assemble(fb)
+        if not callable(t):
+            t = np.asarray(t, float)
+            if t.shape != (self.dim,):
+                raise ValueError("traction on {!r} must have {} components, "
+                                 "got shape {}".format(name, self.dim,
+                                                       t.shape))
+
+        def load(v, w):
+            tv = t(w.x) if callable(t) else t[:, None, None]
+            return sum(tv[a] * v[a] for a in range(self.dim))
+        return fem.LinearForm(load).assemble(fb)
 
     # -- solving -------------------------------------------------------
     def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
-              tangent="consistent", **basis_kwargs):
-        """Solve with ``"PG"`` (``basis_kwargs`` go to ``FamilyBasis``,
-        e.g. ``method="PPG1"``), a thesis name (``"VCBCPBG V5sn Unl TL"``,
-        :mod:`skfem_pg.naming`; ``basis_kwargs`` override it) or an FE
-        method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``); returns a
-        :class:`Result`."""
+              tangent="consistent", tol=1e-9, **basis_kwargs):
+        """Solve with a thesis name (``"VCBCPBG V5sn UnlP0"``, ``"PBG
+        IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
+        basis options), ``"PG"`` (the displacement formulation;
+        ``basis_kwargs`` go to ``FamilyBasis``, e.g. ``method="PPG1"``) or
+        an FE method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``);
+        ``tol``: Newton's relative residual tolerance
+        (:func:`~skfem_pg.solvers.newton`).  Returns a :class:`Result`."""
         basis, model, f, D, u_D, t_pre = self.setup(
             scheme, mesh, tangent, **basis_kwargs)
-        u, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
-                         solver=solver, verbose=verbose)
+        x, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
+                         solver=solver, verbose=verbose, tol=tol)
         times = {"preprocess": t_pre,
                  "assemble": sum(h["t_assemble"] for h in hist),
                  "solve": sum(h["t_linear"] for h in hist)}
-        return Result(scheme, u, basis, self.evaluate(basis, u), times, hist)
+        u = x[:model.n_u]
+        return Result(scheme, u, basis, self.evaluate(basis, u), times, hist,
+                      fields=model.fields(x), model=model, x=x, f_ext=f)
 
     def setup(self, scheme="PG", mesh=None, tangent="consistent",
               **basis_kwargs):
         """What :meth:`solve` hands Newton's method: ``(basis, model,
-        f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`)."""
-        from ..naming import fe_method, parse
+        f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`);
+        ``u_D(t)`` gives the prescribed values at load factor ``t``."""
+        from ..naming import fe_method, formulation_of, parse
         method = fe_method(scheme) or scheme
         t0 = time.perf_counter()
+        formulation = "Unl"
         if method not in FE_METHODS and method != "PG":
             try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
                 kw, _ = parse(method)
@@ -227,12 +311,13 @@ class Scene:
                                  .format(method, ", ".join(FE_METHODS),
                                          err)) from None
             basis_kwargs = {**kw, **basis_kwargs}
+            formulation = formulation_of(method)
             method = "PG"
         if method == "PG":
             mesh = self.mesh if mesh is None else mesh
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
                                 **basis_kwargs)
-            model = Hyperelastic(basis, self.material, tangent=tangent)
+            model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         elif method in FE_METHODS:
@@ -240,14 +325,7 @@ class Scene:
             _, E = FE_METHODS[method]
             basis = fem.Basis(mesh, fem.ElementVector(E()),
                               intorder=INTORDER.get(method))
-            if method.endswith("P0"):
-                m = self.material
-                if not isinstance(m, NeoHookeIsoVol):
-                    raise ValueError("{} (mean dilatation) needs the iso/vol "
-                                     "neo-Hooke material".format(method))
-                model = MeanDilatation(basis, m.mu, m.K)
-            else:
-                model = Hyperelastic(basis, self.material)
+            model = model_for(method, basis, self.material)
             f = sum((self._fe_traction(basis, mesh, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         else:
@@ -273,6 +351,27 @@ class Scene:
                 xi = inside(basis.mesh, x[:, None])
                 out[label] = (basis.probes(xi) @ u).reshape(d)
         return out
+
+
+def _callable_key(f):
+    """A reproducible description of a function for cache keys: module,
+    name, byte code, constants, defaults and closure values (no memory
+    addresses)."""
+    code = getattr(f, "__code__", None)
+    if code is None:
+        return repr(type(f))
+    def value(c):
+        if callable(c):
+            return _callable_key(c)
+        if isinstance(c, np.ndarray):
+            return (c.shape, hashlib.sha1(np.ascontiguousarray(c)
+                                          .tobytes()).hexdigest())
+        return repr(c)
+    cells = [value(c.cell_contents) for c in (f.__closure__ or ())]
+    return (getattr(f, "__module__", ""), getattr(f, "__qualname__", ""),
+            hashlib.sha1(code.co_code).hexdigest(),
+            repr(code.co_consts), repr(code.co_names),
+            [value(c) for c in (f.__defaults__ or ())], cells)
 
 
 def centroid_tree(mesh):

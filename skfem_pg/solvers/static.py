@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from ..dofs import as_dofs, check_vector as _vector
+from ..dofs import as_dofs
 from .linear import linear_solver
 
 
@@ -39,7 +39,14 @@ class ConvergenceError(RuntimeError):
 PG_CANDIDATES = 12
 
 
-def _condensed_solver(kind, basis, I):
+def _condensed_solver(kind, basis, I, extra_fields=False):
+    if extra_fields:  # a saddle point or a coupled u-p system: no
+        # rigid-body AMG; the direct solve (partial pivoting)
+        if kind == "amg":
+            raise ValueError("the AMG solver is for displacement unknowns; "
+                             "this model has extra global fields: use "
+                             "solver='direct' (or 'auto')")
+        return linear_solver("direct", None)
     locs = getattr(basis, "doflocs", None)
     return linear_solver(kind, None if locs is None else locs[:, I],
                          symmetric=getattr(basis, "test", None) is None,
@@ -50,19 +57,29 @@ def _condensed_solver(kind, basis, I):
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
            predictor=True, verbose=True):
-    r"""Solve :math:`f_{int}(u) = \lambda f_{ext}` up to :math:`\lambda = 1`
+    r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
     Parameters
     ----------
     model
         A :mod:`skfem_pg.formulations` model, e.g.
-        ``Hyperelastic(basis, NeoHooke(lam, mu))``.
+        ``Hyperelastic(basis, NeoHooke(lam, mu))``.  Its unknowns ``x``
+        are the displacements (``model.n_u``, scikit-fem numbering of
+        ``model.basis``) followed by its global extra fields, if any
+        (``model.N`` in all).
     f_ext
-        External force vector at load factor 1 (default 0).
+        External force vector at load factor 1 (default 0): one entry per
+        displacement dof (or per unknown).
     D, u_D
-        Prescribed dofs and their values at load factor 1 (full-length
-        vector; default 0).
+        Prescribed displacement dofs and their values: a vector (one entry
+        per displacement dof, or per unknown; only the entries at ``D``
+        are read) at load factor 1, scaled by the load factor, or a
+        callable ``u_D(t)`` returning that vector at load factor ``t``
+        (e.g. a rotation, which is not ``t`` times its end value).
+        Default 0.
+    u0
+        Initial unknowns (displacements, or all unknowns).
     steps
         Initial number of load steps (the step then adapts).
     tol
@@ -82,19 +99,32 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
 
     Returns
     -------
-    u, history
-        ``history`` is a list of dicts per converged step (load factor,
-        residual norms per iteration, minimum J, seconds).
+    x, history
+        ``x``: all unknowns (``model.N``; the displacements are
+        ``x[:model.n_u]``).  ``history`` is a list of dicts per converged
+        step (load factor, residual norms per iteration, minimum J,
+        seconds).
 
     """
     basis = model.basis
-    N = basis.N
-    Dd = as_dofs(D, N)
+    N = getattr(model, "N", basis.N)
+    n_u = getattr(model, "n_u", N)
+    Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     I = np.setdiff1d(np.arange(N), Dd)
-    f_ext = np.zeros(N) if f_ext is None else _vector(f_ext, N, "f_ext")
-    u_D = np.zeros(N) if u_D is None else _vector(u_D, N, "u_D")
-    u = np.zeros(N) if u0 is None else _vector(u0, N, "u0").copy()
-    lin = solver if callable(solver) else _condensed_solver(solver, basis, I)
+    f_ext = _padded(f_ext, n_u, N, "f_ext")
+    if callable(u_D):
+        values = u_D
+
+        def prescribed(t):
+            return _padded(values(t), n_u, N, "u_D(t)")
+    else:
+        u_D1 = _padded(u_D, n_u, N, "u_D")
+
+        def prescribed(t):
+            return t * u_D1
+    u = _padded(u0, n_u, N, "u0")
+    lin = solver if callable(solver) else _condensed_solver(
+        solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam, dlam = 0.0, 1.0 / steps
     prev = None  # (load, u) of the converged step before the last
@@ -106,8 +136,9 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         if predictor and prev is not None:
             start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
         n_krylov = len(stats["iterations"])
-        ok, uk, info = _newton_step(model, start, target, f_ext, Dd, u_D, I,
-                                    lin, tol, maxiter)
+        ok, uk, info = _newton_step(model, start, target, f_ext, Dd,
+                                    prescribed(target)[Dd], I, lin, tol,
+                                    maxiter)
         info.update(load=target, seconds=time.perf_counter() - t0,
                     krylov=stats["iterations"][n_krylov:])
         if verbose:
@@ -137,21 +168,45 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     return u, history
 
 
-def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
-    """Newton iterations at load factor ``lam`` from the converged ``u``.
+def _padded(v, n_u, N, what):
+    """A vector of one entry per displacement dof (zeros appended for the
+    extra fields) or per unknown; ``None`` gives zeros."""
+    if v is None:
+        return np.zeros(N)
+    v = np.asarray(v, dtype=float).ravel()
+    if v.shape == (n_u,) and N > n_u:
+        return np.concatenate([v, np.zeros(N - n_u)])
+    if v.shape != (N,):
+        raise ValueError("{} must have one entry per displacement dof ({}){}"
+                         ", got {}".format(what, n_u, "" if N == n_u else
+                                           " or per unknown ({})".format(N),
+                                           v.shape[0]))
+    return v.copy()
+
+
+def _small_increment(model, du, u):
+    """Every field's Newton increment below 1e-10 of its magnitude."""
+    blocks = getattr(model, "blocks", [("u", slice(None))])
+    return all(np.abs(du[b]).max(initial=0.0)
+               <= 1e-10 * np.abs(u[b]).max(initial=0.0) for _, b in blocks)
+
+
+def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
+    """Newton iterations at load factor ``lam`` from the converged ``u``;
+    ``u_DD`` are the prescribed values at ``Dd`` at this load.
 
     The increment of the prescribed displacements enters the first linear
     solve (``K_II du_I = -r_I - K_ID du_D``), so it is spread through the
     body instead of distorting the boundary layer.
     """
     u = u.copy()
-    du_D = lam * u_D[Dd] - u[Dd]
+    du_D = u_DD - u[Dd]
     pending = bool(np.any(du_D != 0))
     res = []
     info = {"residuals": res, "min_J": np.nan, "reason": "",
             "t_assemble": 0.0, "t_linear": 0.0}
     ref = None
-    du_norm = np.inf
+    small = False
     for it in range(maxiter + 1):
         t0 = time.perf_counter()
         state = model.state(u)
@@ -169,7 +224,7 @@ def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
         if not pending:
             if ref is None:
                 ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
-            if rn <= tol * ref or du_norm <= 1e-10 * np.abs(u).max():
+            if rn <= tol * ref or small:
                 return True, u, info
             if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
                 info["reason"] = "diverging"
@@ -188,8 +243,8 @@ def _newton_step(model, u, lam, f_ext, Dd, u_D, I, lin, tol, maxiter):
         du[I] = lin(K[I][:, I].tocsr(), rhs)
         info["t_assemble"] += t1 - t0
         info["t_linear"] += time.perf_counter() - t1
-        du_norm = np.abs(du).max()
         u += du
+        small = _small_increment(model, du, u)
         pending = False
     info["reason"] = "maxiter"
     return False, u, info
