@@ -8,14 +8,18 @@ What the mixed formulations need beyond a form:
   (a family's PBG weights :math:`w_{kj} = V^k V^j/V_H^k` (4.30) sum to
   :math:`V^k`, an FE element's Gauss weights to its volume);
 * :meth:`Elements.spread` — a per-element value at every point;
-* :meth:`Elements.gradient_vectors` — local vectors
-  :math:`g_e[i, c] = \sum_j w_{ej}\, Q_{c\beta}^{ej} \partial_\beta
-  N_i^{ej}`, the discrete :math:`\int_e Q : \nabla\delta u` (e.g.
-  :math:`Q = J F^{-T}` for the pressure coupling of (6.3)/(6.5));
-* :meth:`Elements.outer` — the sparse :math:`\sum_e c_e\, g_e\otimes g_e`
+* :meth:`Elements.polynomials` — constant and linear functions per
+  element (the p, Theta spaces of UnlP0 (6.9) and U2P1 (6.10));
+* :meth:`Elements.gram` — their weighted Gram matrices;
+* :meth:`Elements.moments` — local moments
+  :math:`C_e[i, c, a] = \sum_j w_{ej}\, \Phi_a^{ej} Q_{c\beta}^{ej}
+  \partial_\beta N_i^{ej}` (order 0: the discrete
+  :math:`\int_e Q : \nabla\delta u`, e.g. :math:`Q = J F^{-T}` for the
+  pressure coupling of (6.3)/(6.5));
+* :meth:`Elements.quadratic` — the sparse :math:`\sum_e C_e^T S_e C_e`
   (the condensed volumetric tangent (6.6));
-* :meth:`Elements.coupling` — the sparse :math:`(N_u \times n_e)` matrix
-  with columns :math:`g_e` (the :math:`K_{up}` block of (6.5)).
+* :meth:`Elements.coupling` — the sparse :math:`(N_u \times n_e q)`
+  matrix with the moments as columns (the :math:`K_{up}` block of (6.5)).
 
 Point data use the layout of the basis' ``interpolate``: FE ``(nel, nq)``,
 family bases the flat ``(1, N_q)`` of :mod:`skfem_pg.discretization.layout`.
@@ -68,19 +72,72 @@ class Elements:
             out[..., g.flat] = e[..., g.families, None]
         return out[..., None, :]
 
-    def gradient_vectors(self, Q):
-        r"""Per block ``(ne_b, nloc, nc)`` local vectors
-        :math:`g_e[i, c] = \sum_j w_{ej} Q_{c\beta}^{ej} \partial_\beta
-        N_i^{ej}` of point tensors ``Q`` ``(d, d, *point_shape)``; a list
-        in the order of the view's blocks."""
+    def positions(self):
+        """Reference coordinates of the points, ``(d, *point_shape)``:
+        Gauss points, or family members (the particles)."""
+        if self.family:
+            L = self.basis.layout
+            x = self.basis.particles.x
+            flat = np.empty((x.shape[0], L.n_points))
+            for g in L:
+                flat[:, g.flat] = x[:, g.members]
+            return flat[:, None, :]
+        return np.asarray(self.basis.global_coordinates().value)
+
+    def polynomials(self, order):
+        r"""Per-element polynomial basis at the points,
+        ``(q, *point_shape)``: ``order=0`` the constant (q = 1),
+        ``order=1`` also :math:`(X - X_c^e)/h_e` (q = 1 + d), centred on
+        the weighted centroid :math:`X_c^e = \sum_j w_{ej} X^{ej} / V_e`
+        (for a family the volume barycentre (6.16)) and scaled by
+        :math:`h_e = V_e^{1/d}`."""
+        ones = np.ones((1,) + self.point_shape)
+        if order == 0:
+            return ones
+        if order != 1:
+            raise ValueError("polynomial order 0 or 1, got {!r}".format(
+                order))
+        X = self.positions()
+        d = X.shape[0]
+        Xc = self.sum(X) / self.volumes
+        h = self.volumes ** (1.0 / d)
+        return np.concatenate([ones, (X - self.spread(Xc))
+                               / self.spread(h)])
+
+    def gram(self, Phi, D=1.0):
+        r""":math:`\sum_j w_{ej} D_{ej} \Phi_a^{ej}\Phi_b^{ej}`,
+        ``(n, q, q)``."""
+        PP = Phi[:, None] * Phi[None] * D
+        return np.moveaxis(self.sum(PP), -1, 0)
+
+    def moments(self, Q, Phi):
+        r"""Per block ``(ne_b, nloc, nc, q)`` local moments
+        :math:`C_e[i, c, a] = \sum_j w_{ej}\, \Phi_a^{ej}\, Q_{c\beta}^{ej}
+        \partial_\beta N_i^{ej}` of point tensors ``Q``
+        ``(d, d, *point_shape)`` against the polynomials ``Phi`` (order 0:
+        the discrete :math:`\int_e Q : \nabla\delta u`); a list in the
+        order of the view's blocks."""
         d = self.view.dim
         out = []
         for blk in self.view.blocks:
             Gh = blk.ext_grad(slice(None), range(1, d + 1))  # (k, j, i, b)
-            Qb = self._take(Q, blk)  # (c, b, k, j)
-            Qw = Qb * blk.dx
-            out.append(np.einsum("cbkj,kjib->kic", Qw, Gh))
+            Qw = self._take(Q, blk) * blk.dx  # (c, b, k, j)
+            Pb = self._take(Phi, blk)  # (a, k, j)
+            QP = np.einsum("cbkj,akj->kjcba", Qw, Pb)
+            out.append(np.einsum("kjcba,kjib->kica", QP, Gh))
         return out
+
+    def quadratic(self, C, S):
+        r"""Sparse :math:`\sum_e C_e^T S_e C_e` (``N × N``) for the local
+        moments ``C`` of :meth:`moments` and per-element symmetric ``S``
+        ``(n, q, q)``."""
+        Sb = [np.asarray(S)[blk.index] for blk in self.view.blocks]
+
+        def local_matrices(bi, blk, sl):
+            Cb = C[bi][sl]  # (k, l, c, a)
+            SC = np.einsum("kab,kicb->kica", Sb[bi][sl], Cb)
+            return np.einsum("klca,kida->klicd", Cb, SC)
+        return assemble_local(self.basis, local_matrices, self.view)
 
     def _take(self, a, blk):
         """Point data ``(..., *point_shape)`` of the block's elements,
@@ -91,28 +148,19 @@ class Elements:
         nc = self.view.nc
         return nc * blk.conn[:, :, None] + np.arange(nc)  # (ne_b, nloc, nc)
 
-    def outer(self, g, c):
-        r"""Sparse :math:`\sum_e c_e\, g_e\otimes g_e` (``N × N``) for the
-        local vectors ``g`` of :meth:`gradient_vectors` and per-element
-        coefficients ``c`` ``(n,)``."""
-        cb = [np.asarray(c)[blk.index] for blk in self.view.blocks]
-
-        def local_matrices(bi, blk, sl):
-            gb = g[bi][sl]  # (k, l, c)
-            return (cb[bi][sl, None, None, None, None]
-                    * gb[:, :, None, :, None] * gb[:, None, :, None, :])
-        return assemble_local(self.basis, local_matrices, self.view)
-
-    def coupling(self, g):
-        r"""Sparse ``(N, n)`` matrix whose column ``e`` is :math:`g_e`
-        scattered to the global dofs."""
+    def coupling(self, C):
+        r"""Sparse ``(N, n q)`` matrix whose column ``e q + a`` is the
+        moment :math:`C_e[:, :, a]` of :meth:`moments` scattered to the
+        global dofs (order 0: column ``e`` is the discrete
+        :math:`\int_e Q : \nabla N`)."""
         rows, cols, vals = [], [], []
-        for blk, gb in zip(self.view.blocks, g):
-            dofs = self._dofs(blk)
-            rows.append(dofs.ravel())
-            cols.append(np.broadcast_to(blk.index[:, None, None],
-                                        dofs.shape).ravel())
-            vals.append(gb.ravel())
+        q = C[0].shape[-1]
+        for blk, Cb in zip(self.view.blocks, C):
+            dofs = self._dofs(blk)[..., None]
+            col = q * blk.index[:, None, None, None] + np.arange(q)
+            rows.append(np.broadcast_to(dofs, Cb.shape).ravel())
+            cols.append(np.broadcast_to(col, Cb.shape).ravel())
+            vals.append(Cb.ravel())
         return sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows),
                                                      np.concatenate(cols))),
-                             shape=(self.basis.N, self.n)).tocsr()
+                             shape=(self.basis.N, self.n * q)).tocsr()

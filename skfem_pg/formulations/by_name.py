@@ -7,13 +7,15 @@ token                   model
 ``Unl``, ``U1``, ``U2``  :class:`~.displacement.Hyperelastic` (PG)
 ``T1`` ... ``H2``       :class:`~.displacement.Hyperelastic` (FE)
 ``UnlP0``               :class:`~.dilatation.MeanDilatation` (PBG)
+``U2P1``                :class:`~.dilatation.MeanDilatation` of order 1
+                        (PBG, WTE2 basis)
 ``Q1P0``, ``H1P0``      :class:`~.dilatation.MeanDilatation`, or with an
                         incompressible material
                         :class:`~.incompressible.IncompressibleP0`
 ``IUnlP0``              :class:`~.incompressible.IncompressibleP0` (PBG)
 ======================  ===================================================
 
-``U2P1``, ``U2P1C``, ``Unl+P1C`` (6.2) and ``U1SUnl``, ``U1SIG`` (6.3)
+``U2P1C``, ``Unl+P1C`` (6.2) and ``U1SUnl``, ``U1SIG`` (6.3)
 parse (:mod:`skfem_pg.naming`) but are not built yet: they raise
 ``NotImplementedError``.
 """
@@ -26,7 +28,7 @@ from .incompressible import IncompressibleP0
 #: built formulation tokens beyond the displacement ones
 MIXED = {"UnlP0": MeanDilatation, "IUnlP0": IncompressibleP0}
 #: Table 7.1's formulations that parse but are not built yet
-PLANNED = ("U2P1", "U2P1C", "Unl+P1C", "U1SUnl", "U1SIG")
+PLANNED = ("U2P1C", "Unl+P1C", "U1SUnl", "U1SIG")
 
 
 def _incompressible(material):
@@ -39,13 +41,18 @@ def model_for(formulation, basis, material, tangent="consistent"):
     if formulation in PLANNED:
         raise NotImplementedError(
             "formulation {!r} (thesis {}) is not built yet; built: U1, Unl, "
-            "U2, UnlP0, IUnlP0 and the FE comparators".format(
+            "U2, UnlP0, IUnlP0, U2P1 and the FE comparators".format(
                 formulation, "6.3" if formulation.startswith("U1S")
                 else "6.2"))
     if formulation in ("Q1P0", "H1P0"):
         cls = IncompressibleP0 if _incompressible(material) \
             else MeanDilatation
         return cls.of(basis, material)
+    if formulation == "U2P1":
+        if _incompressible(material):
+            raise ValueError("U2P1 condenses p and Theta with a finite bulk "
+                             "modulus; nu = 0.5 is not built for it")
+        return MeanDilatation.of(basis, material, order=1)
     if formulation in MIXED:
         if formulation == "UnlP0" and _incompressible(material):
             raise ValueError("UnlP0 condenses the pressure with a finite "

@@ -1,41 +1,45 @@
-r"""One dilatation and one pressure per element, condensed: FE Q1P0 / H1P0
-(Simo–Taylor–Pister mean dilatation) and PBG UnlP0 (thesis 6.2.1).
+r"""Pressure and dilatation as polynomials per element, condensed: FE Q1P0 /
+H1P0 (Simo–Taylor–Pister mean dilatation), PBG UnlP0 (thesis 6.2.1) and
+U2P1 (6.2.2).
 
-The iso/vol neo-Hooke (2.43) with the volumetric part on a per-element
-dilatation :math:`\Theta_e` and pressure :math:`p_e` — an FE element, or a
-family :math:`H^k` with the PBG weights :math:`w_{kj} = V^kV^j/V_H^k`
-(4.30) as its quadrature, (6.3) with :math:`p^{kj} = p^k`,
-:math:`\Theta^{kj} = \Theta^k` (6.9):
+The iso/vol neo-Hooke (2.43) with the volumetric part on a dilatation
+:math:`\Theta` and a pressure :math:`p` that are polynomials of degree
+``order`` on each element — an FE element, or a family :math:`H^k` with the
+PBG weights :math:`w_{kj} = V^kV^j/V_H^k` (4.30) as its quadrature; (6.3):
 
 .. math::
 
-    \Pi = \sum_e \Big[\sum_j w_{ej} W_{iso}(F^{ej})
-          + V_e U(\Theta_e) + p_e\Big(\sum_j w_{ej} J^{ej}
-          - V_e\Theta_e\Big)\Big],
+    \Pi = \sum_e \sum_j w_{ej}\Big[W_{iso}(F^{ej}) + U(\Theta^{ej})
+          + p^{ej}\big(J^{ej} - \Theta^{ej}\big)\Big],
     \qquad U(\Theta) = \tfrac K4(\Theta^2 - 1 - 2\ln\Theta),
 
-:math:`V_e = \sum_j w_{ej}` (for a family :math:`V^k`).  Stationarity in
-the local :math:`p_e, \Theta_e` gives the condensation (6.6) in closed form:
+with :math:`p^{ej} = \sum_a \Phi_a^{ej} p_a^e` (same for :math:`\Theta`):
+order 0, :math:`\Phi = 1`, one p and one Θ per element — UnlP0 (6.9),
+Q1P0, H1P0; order 1, :math:`\Phi = (1, (X^j - X_c^e)/h_e)`, linear p and Θ
+per family — U2P1 (6.10), ``2(d + 1)`` local unknowns.  Stationarity in the
+local unknowns is the static condensation (6.6) in closed form:
 
 .. math::
 
-    \Theta_e = \frac1{V_e}\sum_j w_{ej} J^{ej}, \qquad
-    p_e = U'(\Theta_e) = \tfrac K2(\Theta_e - 1/\Theta_e),
+    \Theta = \Pi_e J, \qquad p = \Pi_e U'(\Theta), \qquad
+    \Pi_e = \Phi M_e^{-1}\Phi^T W_e,\quad M_e = \Phi^T W_e \Phi,
 
-the residual :math:`\sum_j w_{ej}(P_{iso} + p_e J F^{-T}) : \nabla\delta u`
-(the volumetric force (6.8) with :math:`P_{vol} = J p F^{-T}`) and the
-tangent
+the weighted :math:`L^2` projection onto the element's polynomials (for
+order 0 the mean :math:`\Theta_e = \sum_j w_{ej}J^{ej}/V_e`).  The residual
+is :math:`\sum_j w_{ej}(P_{iso} + p^{ej} J F^{-T}) : \nabla\delta u` (the
+volumetric force (6.8), :math:`P_{vol} = J p F^{-T}`) and the tangent
 
 .. math::
 
-    K = \sum_e\sum_j w_{ej}\,\nabla\delta u : (\mathbb A_{iso}
-        + p_e\,\partial_F(JF^{-T})) : \nabla du
-        + \sum_e \frac{U''(\Theta_e)}{V_e}\, g_e\otimes g_e, \qquad
-    g_e = \sum_j w_{ej}\, J F^{-T} : \nabla N^{ej},
+    K = \sum_{ej} w_{ej}\,\nabla\delta u : (\mathbb A_{iso}
+        + p^{ej}\partial_F(JF^{-T})) : \nabla du
+        + \sum_e C_e^T M_e^{-1} (\Phi^T W_e U''(\Theta)\Phi) M_e^{-1} C_e,
+    \qquad C_e = \Phi^T W_e (JF^{-T} : \nabla N),
 
-a rank-one term per element (:class:`~skfem_pg.discretization.elementwise.
-Elements`, batched over size groups).  PPG UnlP0 (the master evaluation
-:math:`\Theta^k = J^{kk}`) is not built.
+a term of rank ``q`` (1 or d + 1) per element
+(:class:`~skfem_pg.discretization.elementwise.Elements`, batched over size
+groups).  PPG UnlP0 (the master evaluation :math:`\Theta^k = J^{kk}`) is
+not built.
 """
 import numpy as np
 
@@ -55,15 +59,18 @@ def _d_JFinvT(J, Finv):
 
 
 class MeanDilatation(Hyperelastic):
-    """Q1P0 / H1P0 on a scikit-fem vector basis, UnlP0 on a PBG
-    :class:`~skfem_pg.FamilyBasis` (see the module docstring), for the
-    iso/vol neo-Hooke with shear modulus ``mu`` and bulk modulus ``K``.
+    """Condensed polynomial pressure and dilatation per element (see the
+    module docstring): ``order=0`` is Q1P0 / H1P0 on a scikit-fem vector
+    basis and UnlP0 on a PBG :class:`~skfem_pg.FamilyBasis`; ``order=1`` on
+    a WTE2 family basis is U2P1.  Iso/vol neo-Hooke with shear modulus
+    ``mu`` and bulk modulus ``K``.
 
-    ``fields(u)`` gives the per-element (per-family) pressure ``p`` and
-    dilatation ``Theta``.
+    ``fields(u)`` gives, per element (family), the pressure ``p`` and
+    dilatation ``Theta`` at the centroid (order 1 also their gradients
+    ``p_grad``, ``Theta_grad``, ``(n, d)``).
     """
 
-    def __init__(self, basis, mu, K):
+    def __init__(self, basis, mu, K, order=0):
         if getattr(basis, "is_petrov", False):
             raise NotImplementedError(
                 "UnlP0 on a Petrov–Galerkin basis (PPG UnlP0: the "
@@ -71,47 +78,62 @@ class MeanDilatation(Hyperelastic):
                 "use a PBG basis")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
-        self.elements = Elements(basis)
+        self.order = int(order)
+        E = self.elements = Elements(basis)
+        self.Phi = E.polynomials(self.order)
+        self._Minv = np.linalg.inv(E.gram(self.Phi))
 
     @classmethod
-    def of(cls, basis, material):
+    def of(cls, basis, material, order=0):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
         if not isinstance(material, NeoHookeIsoVol):
             raise ValueError("a mean-dilatation formulation (Q1P0, H1P0, "
-                             "UnlP0) needs the iso/vol neo-Hooke material "
-                             "(NeoHookeIsoVol), got {!r}".format(material))
-        return cls(basis, material.mu, material.K)
+                             "UnlP0, U2P1) needs the iso/vol neo-Hooke "
+                             "material (NeoHookeIsoVol), got {!r}".format(
+                                 material))
+        return cls(basis, material.mu, material.K, order=order)
+
+    def project(self, a):
+        """Coefficients ``(n, q)`` of the weighted L2 projection of point
+        data ``a`` onto each element's polynomials."""
+        rhs = np.moveaxis(self.elements.sum(self.Phi * a), 0, -1)
+        return np.einsum("nab,nb->na", self._Minv, rhs)
+
+    def evaluate(self, c):
+        """Point values of per-element coefficients ``c`` ``(n, q)``."""
+        return (self.Phi * self.elements.spread(c.T)).sum(axis=0)
 
     def pressure(self, Theta):
         """:math:`U'(\\Theta)`."""
         return 0.5 * self.K * (Theta - 1.0 / Theta)
 
-    def _stiffness(self, Theta):
-        """:math:`U''(\\Theta)`."""
-        return 0.5 * self.K * (1.0 + 1.0 / Theta ** 2)
-
     @kernel
     def state(self, u):
         s = super().state(u)
         Finv, J = inverse_and_det(s["F"])
-        E = self.elements
-        Theta = E.sum(J) / E.volumes
-        s.update(Finv=Finv, J=J, Theta=Theta,
-                 p=E.spread(self.pressure(Theta)))
+        c_Theta = self.project(J)
+        Theta = self.evaluate(c_Theta)
+        c_p = self.project(self.pressure(Theta))
+        s.update(Finv=Finv, J=J, Theta=Theta, c_Theta=c_Theta, c_p=c_p,
+                 p=self.evaluate(c_p))
         return s
 
     def min_J(self, state):
         return float(min(state["J"].min(), state["Theta"].min()))
 
     def energy(self, state):
-        E = self.elements
         Th = state["Theta"]
         U = 0.25 * self.K * (Th ** 2 - 1 - 2 * np.log(Th))
-        return super().energy(state) + float(np.sum(E.volumes * U))
+        return super().energy(state) + float(np.sum(self.elements.sum(U)))
 
     def fields(self, x):
         s = self.state(x)
-        return {"p": self.pressure(s["Theta"]), "Theta": s["Theta"]}
+        out = {"p": s["c_p"][:, 0], "Theta": s["c_Theta"][:, 0]}
+        if self.order == 1:
+            h = self.elements.volumes ** (1.0 / self.elements.view.dim)
+            out["p_grad"] = s["c_p"][:, 1:] / h[:, None]
+            out["Theta_grad"] = s["c_Theta"][:, 1:] / h[:, None]
+        return out
 
     @kernel
     def stress(self, state):
@@ -120,10 +142,14 @@ class MeanDilatation(Hyperelastic):
                 + state["p"] * state["J"] * FinvT)
 
     def _volumetric_tangent(self, state):
-        """The rank-one terms :math:`U''/V_e\\, g_e\\otimes g_e`."""
+        """:math:`\\sum_e C_e^T M^{-1}(\\Phi^T W U''\\Phi) M^{-1} C_e`."""
         E = self.elements
-        g = E.gradient_vectors(state["J"] * np.swapaxes(state["Finv"], 0, 1))
-        return E.outer(g, self._stiffness(state["Theta"]) / E.volumes)
+        Th = state["Theta"]
+        Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
+        S = self._Minv @ E.gram(self.Phi, Upp) @ self._Minv
+        C = E.moments(state["J"] * np.swapaxes(state["Finv"], 0, 1),
+                      self.Phi)
+        return E.quadratic(C, S)
 
     @kernel
     def tangent(self, state):
@@ -131,4 +157,3 @@ class MeanDilatation(Hyperelastic):
             state["J"], state["Finv"])
         return (assemble(material_tangent, self.basis, A=A)
                 + self._volumetric_tangent(state))
-

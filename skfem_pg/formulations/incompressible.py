@@ -61,6 +61,7 @@ class IncompressibleP0(Hyperelastic):
                 "built; use a PBG basis")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.elements = Elements(basis)
+        self._Phi = self.elements.polynomials(0)
 
     @classmethod
     def of(cls, basis, material):
@@ -124,6 +125,6 @@ class IncompressibleP0(Hyperelastic):
             state["J"], state["Finv"])
         Kuu = assemble(material_tangent, self.basis, A=A)
         E = self.elements
-        G = E.coupling(E.gradient_vectors(
-            state["J"] * np.swapaxes(state["Finv"], 0, 1)))
+        G = E.coupling(E.moments(
+            state["J"] * np.swapaxes(state["Finv"], 0, 1), self._Phi))
         return sp.bmat([[Kuu, G], [G.T, None]], format="csr")
