@@ -7,10 +7,14 @@ The model interface (fields, residual, tangent) is described in
 ``linear``         linear elasticity as a plain scikit-fem form
 ``displacement``   :class:`Hyperelastic`: the displacement formulation (PG
                    U1/Unl/U2, FE T1/Q1/O1/H1/...)
-``dilatation``     :class:`MeanDilatation`: one condensed pressure and
-                   dilatation per element — FE Q1P0/H1P0, PBG UnlP0
+``dilatation``     :class:`MeanDilatation`: condensed polynomial pressure
+                   and dilatation per element — FE Q1P0/H1P0, PBG UnlP0,
+                   U2P1
 ``incompressible`` :class:`IncompressibleP0`: nu = 0.5, one pressure per
                    element as a global unknown — PBG IUnlP0, FE Q1P0/H1P0
+``nodal``          :class:`NodalPressure`: nodal p and Theta as global
+                   unknowns — PBG U2P1C, Unl+P1C (with a condensed bubble)
+``by_name``        the model of a Table 7.1 formulation token
 ``tangents``       finite-difference tangent of family forces
 =================  ========================================================
 """
@@ -18,8 +22,10 @@ from .linear import linear_elasticity
 from .displacement import Hyperelastic, internal_force, material_tangent
 from .dilatation import MeanDilatation
 from .incompressible import IncompressibleP0
+from .nodal import NodalPressure
+from .by_name import model_for
 from .tangents import fd_tangent
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "IncompressibleP0",
-           "fd_tangent"]
+           "NodalPressure", "model_for", "fd_tangent"]

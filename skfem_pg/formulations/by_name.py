@@ -13,22 +13,25 @@ token                   model
                         incompressible material
                         :class:`~.incompressible.IncompressibleP0`
 ``IUnlP0``              :class:`~.incompressible.IncompressibleP0` (PBG)
+``U2P1C``               :class:`~.nodal.NodalPressure` (PBG, WTE2 basis)
+``Unl+P1C``             :class:`~.nodal.NodalPressure` with the bubble
+                        (PBG, MTE1 basis)
 ======================  ===================================================
 
-``U2P1C``, ``Unl+P1C`` (6.2) and ``U1SUnl``, ``U1SIG`` (6.3)
-parse (:mod:`skfem_pg.naming`) but are not built yet: they raise
-``NotImplementedError``.
+``U1SUnl``, ``U1SIG`` (6.3) parse (:mod:`skfem_pg.naming`) but are not
+built yet: they raise ``NotImplementedError``.
 """
 import numpy as np
 
 from .dilatation import MeanDilatation
 from .displacement import Hyperelastic
 from .incompressible import IncompressibleP0
+from .nodal import NodalPressure
 
 #: built formulation tokens beyond the displacement ones
 MIXED = {"UnlP0": MeanDilatation, "IUnlP0": IncompressibleP0}
 #: Table 7.1's formulations that parse but are not built yet
-PLANNED = ("U2P1C", "Unl+P1C", "U1SUnl", "U1SIG")
+PLANNED = ("U1SUnl", "U1SIG")
 
 
 def _incompressible(material):
@@ -40,10 +43,9 @@ def model_for(formulation, basis, material, tangent="consistent"):
     method) on ``basis`` with ``material``."""
     if formulation in PLANNED:
         raise NotImplementedError(
-            "formulation {!r} (thesis {}) is not built yet; built: U1, Unl, "
-            "U2, UnlP0, IUnlP0, U2P1 and the FE comparators".format(
-                formulation, "6.3" if formulation.startswith("U1S")
-                else "6.2"))
+            "formulation {!r} (thesis 6.3) is not built yet; built: U1, "
+            "Unl, U2, UnlP0, IUnlP0, U2P1, U2P1C, Unl+P1C and the FE "
+            "comparators".format(formulation))
     if formulation in ("Q1P0", "H1P0"):
         cls = IncompressibleP0 if _incompressible(material) \
             else MeanDilatation
@@ -53,6 +55,9 @@ def model_for(formulation, basis, material, tangent="consistent"):
             raise ValueError("U2P1 condenses p and Theta with a finite bulk "
                              "modulus; nu = 0.5 is not built for it")
         return MeanDilatation.of(basis, material, order=1)
+    if formulation in ("U2P1C", "Unl+P1C"):
+        return NodalPressure.of(basis, material,
+                                bubble=formulation == "Unl+P1C")
     if formulation in MIXED:
         if formulation == "UnlP0" and _incompressible(material):
             raise ValueError("UnlP0 condenses the pressure with a finite "

@@ -16,6 +16,8 @@ in the state.  For ``x`` a model evaluates
 * ``tangent(state)``: :math:`\partial^2\Pi/\partial x^2` (sparse ``N × N``),
 * ``min_J(state)``: the smallest :math:`J = \det F` (inversion check),
 * ``fields(x)``: the extra fields by name (per element / family),
+* ``initial()``: the unknowns of the undeformed state (zero
+  displacements and pressures, unit dilatations),
 
 and names its unknowns in ``blocks`` (``(name, slice)``), so that Newton's
 method measures convergence per field.  Loads, Dirichlet dofs and results
@@ -107,6 +109,10 @@ class Hyperelastic:
     def fields(self, x):
         """Extra fields of the solution ``x`` by name (none here)."""
         return {}
+
+    def initial(self):
+        """Unknowns of the undeformed, unloaded state."""
+        return np.zeros(self.N)
 
     @kernel
     def state(self, u):

@@ -84,9 +84,13 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         Initial number of load steps (the step then adapts).
     tol
         Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
-        ``r_0`` is the first residual of the step, or a Newton increment
-        below ``1e-10 |u|`` (the round-off floor of ill-conditioned, e.g.
-        nearly incompressible, problems).
+        ``r_0`` is the first residual of the step; or every field's Newton
+        increment below ``1e-10`` of its magnitude; or the energy of the
+        last increment :math:`|\Delta x\cdot r|` below ``tol²`` times
+        that of the first (a measure in units of work, whatever the
+        fields: with pressures and dilatations as unknowns the residual
+        norm mixes units and stalls at a round-off floor set by the bulk
+        modulus).
     solver
         Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``
         (:func:`linear_solver` on the free dofs), or a callable ``(A, b)
@@ -122,7 +126,8 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
 
         def prescribed(t):
             return t * u_D1
-    u = _padded(u0, n_u, N, "u0")
+    x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
+    u = x0 if u0 is None else _padded(u0, n_u, N, "u0", x0)
     lin = solver if callable(solver) else _condensed_solver(
         solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
@@ -168,14 +173,16 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     return u, history
 
 
-def _padded(v, n_u, N, what):
-    """A vector of one entry per displacement dof (zeros appended for the
-    extra fields) or per unknown; ``None`` gives zeros."""
+def _padded(v, n_u, N, what, rest=None):
+    """A vector of one entry per displacement dof (the extra fields'
+    entries from ``rest``, default zeros, appended) or per unknown;
+    ``None`` gives zeros."""
     if v is None:
         return np.zeros(N)
     v = np.asarray(v, dtype=float).ravel()
     if v.shape == (n_u,) and N > n_u:
-        return np.concatenate([v, np.zeros(N - n_u)])
+        return np.concatenate([v, np.zeros(N - n_u) if rest is None
+                               else rest[n_u:]])
     if v.shape != (N,):
         raise ValueError("{} must have one entry per displacement dof ({}){}"
                          ", got {}".format(what, n_u, "" if N == n_u else
@@ -207,6 +214,7 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
             "t_assemble": 0.0, "t_linear": 0.0}
     ref = None
     small = False
+    energy = []  # |du · rhs| of each solve
     for it in range(maxiter + 1):
         t0 = time.perf_counter()
         state = model.state(u)
@@ -224,7 +232,8 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
         if not pending:
             if ref is None:
                 ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
-            if rn <= tol * ref or small:
+            if rn <= tol * ref or small or (
+                    len(energy) > 1 and energy[-1] <= tol ** 2 * energy[0]):
                 return True, u, info
             if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
                 info["reason"] = "diverging"
@@ -241,6 +250,7 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
             du[Dd] = du_D
             rhs = rhs - K[I][:, Dd] @ du_D
         du[I] = lin(K[I][:, I].tocsr(), rhs)
+        energy.append(abs(float(np.dot(du[I], rhs))))
         info["t_assemble"] += t1 - t0
         info["t_linear"] += time.perf_counter() - t1
         u += du

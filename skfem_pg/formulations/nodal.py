@@ -1,0 +1,298 @@
+r"""Nodal pressure and dilatation as global unknowns: PBG U2P1C (thesis
+(6.11)) and the bubble-enriched Unl+P1C ((6.12)–(6.16)).
+
+Every particle carries :math:`p^i, \Theta^i` beside its displacement.
+Inside family :math:`H^k` both are linear, extrapolated from the master
+with gradients of the displacement basis at the master (6.11):
+
+.. math::
+
+    p^{kj} = p^k + \Big(\sum_i (p^i - p^k)\,\partial N^{kki}\Big)\cdot
+    \Delta X^{kj} = \sum_i N_p^{kji} p^i, \qquad
+    \Delta X^{kj} = X^j - X^k,
+
+(the same for :math:`\Theta`), :math:`\partial N^{kki}` the corrected
+derivatives ``G[k, 0, i]`` of the displacement basis (U2P1C: WTE2; Unl+P1C:
+MTE1 with BC and VC, a linear basis, as the thesis asks).  Unl+P1C adds one
+bubble per family, a local vector :math:`u_b^k`, with (6.12), (6.15),
+(6.16)
+
+.. math::
+
+    F^{kj} = I + \sum_i u^i\otimes\partial N^{kji} + u_b^k\otimes
+    (X^j - X_c^k), \qquad X_c^k = \sum_j V^j X^j / V_H^k,
+
+whose gradient has zero weighted mean (6.14), so the VC integration
+constraint is undisturbed.  The functional is (6.3) with these fields,
+
+.. math::
+
+    \Pi = \sum_k\sum_j w_{kj}\big[W_{iso}(F^{kj}) + U(\Theta^{kj})
+        + p^{kj}(J^{kj} - \Theta^{kj})\big].
+
+Unknowns ``x = [u, p, Θ]``: displacements in scikit-fem numbering, then
+one p and one Θ per particle.  The bubble is condensed (6.6) exactly: for
+given ``x`` a batched local Newton over all families solves
+:math:`R_b^k = \sum_j w_{kj} P^{kj}\,(X^j - X_c^k) = 0` (``d × d`` systems,
+to :math:`|\Delta u_b|\,|X^j - X_c^k| \le 10^{-13}`), so the residual is a
+function of ``x`` alone and its derivative, by the implicit function
+theorem, the condensed tangent :math:`K_{aa} - K_{ab}K_{bb}^{-1}K_{ba}`.
+
+The tangent couples u, p, Θ (a symmetric, indefinite saddle point: the
+direct solver).  p and Θ are global even in explicit runs, the cost the
+thesis notes.
+"""
+import numpy as np
+import scipy.sparse as sp
+
+from ..discretization.assembly import assemble
+from ..discretization.elementwise import Elements
+from ..errors import ParticleError
+from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..threads import kernel
+from .dilatation import _d_JFinvT
+from .displacement import Hyperelastic, internal_force, material_tangent
+
+#: local Newton of the bubble: largest iterations, and the tolerance on
+#: the change of F
+BUBBLE_MAXITER, BUBBLE_TOL = 25, 1e-13
+
+
+class _Group:
+    """Per size group: member indices, weights, derivatives, the p/Θ
+    interpolation ``Np[k, j, i]`` and the bubble gradients ``b[k, j]``."""
+
+    def __init__(self, g, G, dx, x, V):
+        self.flat, self.families, self.members = g.flat, g.families, \
+            g.members
+        self.G, self.dx = G, dx
+        X = x[:, g.members]  # (d, k, j)
+        dX = np.moveaxis(X - X[:, :, :1], 0, -1)  # (k, j, d)
+        a = np.einsum("kid,kjd->kji", G[:, 0], dX)  # G^{kki}·ΔX^{kj}
+        self.Np = a.copy()
+        self.Np[:, :, 0] += 1.0 - a.sum(axis=-1)
+        Vm = V[g.members]
+        Xc = (X * Vm).sum(axis=-1) / Vm.sum(axis=-1)  # (d, k)
+        self.b = np.moveaxis(X - Xc[:, :, None], 0, -1)  # (k, j, d)
+
+
+class NodalPressure(Hyperelastic):
+    """U2P1C (``bubble=False``, on a WTE2 basis) and Unl+P1C
+    (``bubble=True``, on an MTE1 basis) on a PBG
+    :class:`~skfem_pg.FamilyBasis` whose families are mastered by every
+    particle; iso/vol neo-Hooke with shear modulus ``mu`` and bulk modulus
+    ``K`` (see the module docstring).
+
+    ``fields(x)`` gives the nodal ``p`` and ``Theta`` and, with the bubble,
+    its amplitude ``bubble`` per family ``(n_f, d)``.
+    """
+
+    def __init__(self, basis, mu, K, bubble=True):
+        if not hasattr(basis, "layout") or getattr(basis, "is_petrov",
+                                                    False):
+            raise NotImplementedError(
+                "U2P1C and Unl+P1C are built on PBG family bases (got {})"
+                .format(type(basis).__name__ if not hasattr(basis, "layout")
+                        else "a Petrov–Galerkin basis"))
+        super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
+        self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
+        self.bubble = bool(bubble)
+        p, fam = basis.particles, basis.families
+        self.n = p.n
+        masters = np.zeros(p.n, dtype=bool)
+        masters[fam.masters] = True
+        if not masters.all():
+            i = int(np.flatnonzero(~masters)[0])
+            raise ParticleError(
+                "particle {} at {} masters no family: nodal p and Theta "
+                "need a family at every particle (U2P1C / Unl+P1C on a "
+                "subdomain is not built)".format(i, tuple(p.x[:, i])))
+        self.elements = Elements(basis)
+        self.groups = [_Group(g, G, dx, p.x, p.volumes) for g, G, dx in zip(
+            basis.layout, basis.grouped_gradients(),
+            basis.grouped_weights())]
+        L = basis.layout
+        d = p.dim
+        self._b = np.empty((d, 1, L.n_points))
+        for gr in self.groups:
+            self._b[:, 0, gr.flat] = np.moveaxis(gr.b, -1, 0)
+        self._ub = np.zeros((d, L.n_families))  # warm start of the bubble
+
+    @classmethod
+    def of(cls, basis, material, bubble=True):
+        """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
+        if not isinstance(material, NeoHookeIsoVol) \
+                or not np.isfinite(material.K):
+            raise ValueError("U2P1C / Unl+P1C need the iso/vol neo-Hooke "
+                             "material with a finite bulk modulus, got "
+                             "{!r}".format(material))
+        return cls(basis, material.mu, material.K, bubble=bubble)
+
+    @property
+    def N(self):
+        return self.n_u + 2 * self.n
+
+    @property
+    def blocks(self):
+        n_u, n = self.n_u, self.n
+        return [("u", slice(0, n_u)), ("p", slice(n_u, n_u + n)),
+                ("Theta", slice(n_u + n, n_u + 2 * n))]
+
+    def initial(self):
+        """Zero displacements and pressures, unit dilatations."""
+        x = np.zeros(self.N)
+        x[self.n_u + self.n:] = 1.0
+        return x
+
+    def _split(self, x):
+        x = np.asarray(x, dtype=float)
+        if x.shape != (self.N,):
+            raise ValueError("{} unknowns: {} displacements, {} pressures "
+                             "and {} dilatations ({} in all), got shape {}"
+                             .format(type(self).__name__, self.n_u, self.n,
+                                     self.n, self.N, x.shape))
+        n_u, n = self.n_u, self.n
+        return x[:n_u], x[n_u:n_u + n], x[n_u + n:]
+
+    def _at_points(self, nodal):
+        """:math:`\\sum_i N_p^{kji} a^i` in the flat layout ``(1, N_q)``."""
+        out = np.empty((1, self.basis.layout.n_points))
+        for gr in self.groups:
+            out[0, gr.flat] = np.einsum("kji,ki->kj", gr.Np,
+                                        nodal[gr.members])
+        return out
+
+    def _to_nodes(self, a):
+        """:math:`\\sum_k\\sum_j w_{kj} a^{kj} N_p^{kji}` per particle."""
+        out = np.zeros(self.n)
+        for gr in self.groups:
+            r = np.einsum("kj,kj,kji->ki", gr.dx, a[0, gr.flat], gr.Np)
+            out += np.bincount(gr.members.ravel(), r.ravel(),
+                               minlength=self.n)
+        return out
+
+    def _volumetric(self, F, p):
+        Finv, J = inverse_and_det(F)
+        return Finv, J, self.material.stress(F) + p * J * np.swapaxes(
+            Finv, 0, 1)
+
+    def _tangent_field(self, F, Finv, J, p):
+        return self.material.tangent(F) + p * _d_JFinvT(J, Finv)
+
+    @kernel
+    def state(self, x):
+        u, p, Theta = self._split(x)
+        F = super().state(u)["F"]
+        p_pts, Th_pts = self._at_points(p), self._at_points(Theta)
+        s = {"p": p_pts, "Theta": Th_pts}
+        if self.bubble:
+            F, ub, Kbb = self._solve_bubble(F, p_pts)
+            s.update(ub=ub, Kbb=Kbb)
+        Finv, J, P = self._volumetric(F, p_pts)
+        s.update(F=F, Finv=Finv, J=J, P=P)
+        return s
+
+    def _solve_bubble(self, Fu, p):
+        """The bubble amplitudes ``(d, n_f)`` with :math:`R_b = 0`, by a
+        batched Newton from the last ones; also :math:`K_{bb}`."""
+        E, b = self.elements, self._b
+        ub = self._ub.copy()
+        bn = np.abs(b).max()
+        for it in range(BUBBLE_MAXITER):
+            F = Fu + E.spread(ub)[:, None] * b[None]
+            Finv, J, P = self._volumetric(F, p)
+            A = self._tangent_field(F, Finv, J, p)
+            Rb = E.sum(np.einsum("iJ...,J...->i...", P, b))  # (d, nf)
+            Kbb = E.sum(np.einsum("iJkL...,J...,L...->ik...", A, b, b))
+            Kbb = np.moveaxis(Kbb, -1, 0)  # (nf, d, d)
+            dub = -np.linalg.solve(Kbb, Rb.T[..., None])[..., 0].T
+            ub += dub
+            if not np.all(np.isfinite(ub)):
+                break
+            if np.abs(dub).max() * bn <= BUBBLE_TOL:
+                F = Fu + E.spread(ub)[:, None] * b[None]
+                self._ub = ub
+                return F, ub, Kbb
+        # no convergence (e.g. J <= 0 inside a family): let Newton cut
+        nan = np.full_like(Fu, np.nan)
+        return nan, ub, None
+
+    def min_J(self, state):
+        if not np.all(np.isfinite(state["F"])):
+            return -np.inf
+        return float(min(state["J"].min(), state["Theta"].min()))
+
+    def energy(self, state):
+        Th = state["Theta"]
+        U = 0.25 * self.K * (Th ** 2 - 1 - 2 * np.log(Th))
+        dens = self.material.energy(state["F"]) + U + state["p"] * (
+            state["J"] - Th)
+        return float(np.sum(self.basis.flat_weights() * dens))
+
+    def fields(self, x):
+        _, p, Theta = self._split(x)
+        out = {"p": p.copy(), "Theta": Theta.copy()}
+        if self.bubble:
+            out["bubble"] = self.state(x)["ub"].T.copy()
+        return out
+
+    @kernel
+    def stress(self, state):
+        return state["P"]
+
+    @kernel
+    def internal_force(self, state):
+        r_u = assemble(internal_force, self.basis, P=state["P"])
+        Th = state["Theta"]
+        r_p = self._to_nodes(state["J"] - Th)
+        r_t = self._to_nodes(0.5 * self.K * (Th - 1.0 / Th) - state["p"])
+        return np.concatenate([r_u, r_p, r_t])
+
+    @kernel
+    def tangent(self, state):
+        F, Finv, J, p = state["F"], state["Finv"], state["J"], state["p"]
+        A = self._tangent_field(F, Finv, J, p)
+        Kuu = assemble(material_tangent, self.basis, A=A)
+        Q = J * np.swapaxes(Finv, 0, 1)
+        Th = state["Theta"]
+        Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
+        L = self.basis.layout
+        d, n_u, n = self.elements.view.dim, self.n_u, self.n
+        half, full = ([], [], []), ([], [], [])  # (rows, cols, values)
+
+        def add(to, r, c, v):
+            to[0].append(np.broadcast_to(r, v.shape).ravel())
+            to[1].append(np.broadcast_to(c, v.shape).ravel())
+            to[2].append(v.ravel())
+        for gr in self.groups:
+            k, m = gr.members.shape
+            w, Np = gr.dx, gr.Np
+            Qg = L.take(Q, gr)  # (c, b, k, j)
+            udofs = d * gr.members[:, :, None] + np.arange(d)  # (k, i, c)
+            pdofs, tdofs = n_u + gr.members, n_u + n + gr.members
+            # K_up[k, i, c, l] = sum_j w Q_cb G_kjib Np_kjl (and K_pu)
+            add(half, udofs[..., None], pdofs[:, None, None, :],
+                np.einsum("kj,cbkj,kjib,kjl->kicl", w, Qg, gr.G, Np))
+            # K_pT = -sum_j w Np Np (and K_Tp)
+            add(half, pdofs[:, :, None], tdofs[:, None, :],
+                -np.einsum("kj,kji,kjl->kil", w, Np, Np))
+            # K_TT = sum_j w U'' Np Np
+            add(full, tdofs[:, :, None], tdofs[:, None, :],
+                np.einsum("kj,kj,kji,kjl->kil", w, L.take(Upp, gr), Np, Np))
+            if self.bubble:  # - K_ab K_bb^-1 K_ba over the (u, p) dofs
+                b, Ag = gr.b, L.take(A, gr)  # (k, j, d), (c,b,e,L,k,j)
+                Kub = np.einsum("kj,kjib,cbeLkj,kjL->kice", w, gr.G, Ag, b)
+                Kpb = np.einsum("kj,kjl,eLkj,kjL->kle", w, Np, Qg, b)
+                Ka = np.concatenate([Kub.reshape(k, m * d, d), Kpb], axis=1)
+                corr = -Ka @ np.linalg.solve(state["Kbb"][gr.families],
+                                             np.swapaxes(Ka, 1, 2))
+                a = np.concatenate([udofs.reshape(k, m * d), pdofs], axis=1)
+                add(full, a[:, :, None], a[:, None, :], corr)
+
+        def coo(t):
+            return sp.coo_matrix((np.concatenate(t[2]), (
+                np.concatenate(t[0]), np.concatenate(t[1]))),
+                shape=(self.N, self.N)).tocsr()
+        H = coo(half)
+        Kuu.resize((self.N, self.N))
+        return Kuu + H + H.T + coo(full)
