@@ -100,3 +100,74 @@ def infsup_pg(basis, free, **kw):
     n_p = len(basis.families) if basis.shape == "WTE1" \
         else int(basis.families.sizes.sum())
     return infsup(T, S, free, n_p, **kw)
+
+
+def _identity(E):
+    d = E.view.dim
+    return np.broadcast_to(np.eye(d).reshape((d, d) + (1,) * len(
+        E.point_shape)), (d, d) + E.point_shape)
+
+
+def infsup_mixed(model, free, **kw):
+    r"""Inf-sup test of a mixed formulation's displacement–pressure pair,
+    :math:`T = B^T M_p^{-1} B` with :math:`B = \sum q\,\mathrm{div}\,u`
+    and :math:`M_p = \sum p\,q` summed with the formulation's weights:
+
+    * :class:`~skfem_pg.formulations.MeanDilatation` and
+      :class:`~skfem_pg.formulations.IncompressibleP0` — p constant (Q1P0,
+      H1P0, UnlP0, IUnlP0) or linear (U2P1) per element or family;
+    * :class:`~skfem_pg.formulations.NodalPressure` — nodal p extrapolated
+      with the gradients at the master (U2P1C, (6.11)); with the bubble
+      (Unl+P1C) the displacement space holds the bubbles too, ``d`` more
+      unknowns per family, all free (their rows of ``S`` are
+      :math:`\sum_j w_{kj} (X^j - X_c^k)\cdot\ldots`, (6.15)).
+
+    ``free`` are the free displacement dofs (scikit-fem numbering)."""
+    from ..formulations import (IncompressibleP0, MeanDilatation,
+                                NodalPressure)
+    basis = model.basis
+    S = assemble(grad_grad, basis)
+    if isinstance(model, (MeanDilatation, IncompressibleP0)):
+        E = model.elements
+        Phi = E.polynomials(getattr(model, "order", 0))
+        Bt = E.coupling(E.moments(_identity(E), Phi))
+        Minv = np.linalg.inv(E.gram(Phi))
+        T = Bt @ sp.block_diag(list(Minv), format="csr") @ Bt.T
+        return infsup(T, S, free, Bt.shape[1], **kw)
+    if not isinstance(model, NodalPressure):
+        raise TypeError("infsup_mixed takes a MeanDilatation, "
+                        "IncompressibleP0 or NodalPressure model, got "
+                        "{}".format(type(model).__name__))
+    K = model.tangent(model.state(model.initial()))
+    n_u, n = model.n_u, model.n
+    Bt = K[:n_u, n_u:n_u + n]  # sum w div(N) Np at the reference
+    M = -K[n_u:n_u + n, n_u + n:].toarray()
+    if not model.bubble:
+        T = Bt @ sp.csr_matrix(np.linalg.solve(M, Bt.T.toarray()))
+        return infsup(T, S, free, n, **kw)
+    d, nf = basis.particles.dim, basis.layout.n_families
+    Sub, Sbb, Bbt = ([], [], []), np.zeros(nf * d), np.zeros((nf * d, n))
+    for gr in model.groups:
+        # grad of the bubble e_c (x) b^kj: S_ub = sum_j w G^kji . b^kj
+        v = np.einsum("kj,kjib,kjb->ki", gr.dx, gr.G, gr.b)
+        for c in range(d):
+            Sub[0].append((d * gr.members + c).ravel())
+            Sub[1].append((d * gr.families[:, None] + c
+                           + 0 * gr.members).ravel())
+            Sub[2].append(v.ravel())
+            Sbb[d * gr.families + c] = np.einsum("kj,kjb,kjb->k", gr.dx,
+                                                 gr.b, gr.b)
+        # div of the bubble: b^kj_c; against Np^kji
+        r = np.einsum("kj,kjc,kji->kci", gr.dx, gr.b, gr.Np)
+        rows = d * gr.families[:, None, None] + np.arange(d)[:, None]
+        np.add.at(Bbt, (np.broadcast_to(rows, r.shape),
+                        np.broadcast_to(gr.members[:, None, :], r.shape)),
+                  r)
+    Sub = sp.coo_matrix((np.concatenate(Sub[2]), (
+        np.concatenate(Sub[0]), np.concatenate(Sub[1]))),
+        shape=(n_u, nf * d))
+    S = sp.bmat([[S, Sub], [Sub.T, sp.diags(Sbb)]], format="csr")
+    Bt = sp.vstack([Bt, sp.csr_matrix(Bbt)]).tocsr()
+    T = Bt @ sp.csr_matrix(np.linalg.solve(M, Bt.T.toarray()))
+    free = np.concatenate([np.asarray(free), n_u + np.arange(nf * d)])
+    return infsup(T, S, free, n, **kw)

@@ -76,6 +76,29 @@ class _Group:
         self.b = np.moveaxis(X - Xc[:, :, None], 0, -1)  # (k, j, d)
 
 
+class _Pattern:
+    """A fixed sparsity pattern of COO entries ``(rows, cols)``: the CSR
+    structure once, then each new set of values summed into it by one
+    ``bincount``."""
+
+    def __init__(self, rows, cols, N):
+        A = sp.coo_matrix((np.arange(1, len(rows) + 1, dtype=float),
+                           (rows, cols)), shape=(N, N)).tocsr()
+        A.sum_duplicates()
+        self.indptr, self.indices = A.indptr, A.indices
+        # position of every COO entry in the CSR data
+        key = rows.astype(np.int64) * N + cols
+        csr_rows = np.repeat(np.arange(N), np.diff(A.indptr))
+        csr_key = csr_rows.astype(np.int64) * N + A.indices
+        self.pos = np.searchsorted(csr_key, key)
+        self.N, self.nnz = N, len(A.indices)
+
+    def matrix(self, values):
+        data = np.bincount(self.pos, values, minlength=self.nnz)
+        return sp.csr_matrix((data, self.indices, self.indptr),
+                             shape=(self.N, self.N))
+
+
 class NodalPressure(Hyperelastic):
     """U2P1C (``bubble=False``, on a WTE2 basis) and Unl+P1C
     (``bubble=True``, on an MTE1 basis) on a PBG
@@ -117,6 +140,7 @@ class NodalPressure(Hyperelastic):
         for gr in self.groups:
             self._b[:, 0, gr.flat] = np.moveaxis(gr.b, -1, 0)
         self._ub = np.zeros((d, L.n_families))  # warm start of the bubble
+        self._pattern = None  # of the p, Theta and bubble blocks
 
     @classmethod
     def of(cls, basis, material, bubble=True):
@@ -258,11 +282,15 @@ class NodalPressure(Hyperelastic):
         Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
         L = self.basis.layout
         d, n_u, n = self.elements.view.dim, self.n_u, self.n
-        half, full = ([], [], []), ([], [], [])  # (rows, cols, values)
+        # local blocks: (rows, cols, values); the index arrays only until
+        # the sparsity pattern is known (it does not change)
+        half, full = ([], [], []), ([], [], [])
+        indices = self._pattern is None
 
         def add(to, r, c, v):
-            to[0].append(np.broadcast_to(r, v.shape).ravel())
-            to[1].append(np.broadcast_to(c, v.shape).ravel())
+            if indices:
+                to[0].append(np.broadcast_to(r, v.shape).ravel())
+                to[1].append(np.broadcast_to(c, v.shape).ravel())
             to[2].append(v.ravel())
         for gr in self.groups:
             k, m = gr.members.shape
@@ -270,29 +298,36 @@ class NodalPressure(Hyperelastic):
             Qg = L.take(Q, gr)  # (c, b, k, j)
             udofs = d * gr.members[:, :, None] + np.arange(d)  # (k, i, c)
             pdofs, tdofs = n_u + gr.members, n_u + n + gr.members
+            wNp = w[:, :, None] * Np  # (k, j, l)
+            NpT = np.swapaxes(Np, 1, 2)  # (k, l, j)
             # K_up[k, i, c, l] = sum_j w Q_cb G_kjib Np_kjl (and K_pu)
+            QG = np.einsum("cbkj,kjib->kicj", Qg, gr.G).reshape(k, m * d, m)
             add(half, udofs[..., None], pdofs[:, None, None, :],
-                np.einsum("kj,cbkj,kjib,kjl->kicl", w, Qg, gr.G, Np))
+                (QG @ wNp).reshape(k, m, d, m))
             # K_pT = -sum_j w Np Np (and K_Tp)
-            add(half, pdofs[:, :, None], tdofs[:, None, :],
-                -np.einsum("kj,kji,kjl->kil", w, Np, Np))
+            add(half, pdofs[:, :, None], tdofs[:, None, :], -(NpT @ wNp))
             # K_TT = sum_j w U'' Np Np
             add(full, tdofs[:, :, None], tdofs[:, None, :],
-                np.einsum("kj,kj,kji,kjl->kil", w, L.take(Upp, gr), Np, Np))
+                NpT @ (L.take(Upp, gr)[:, :, None] * wNp))
             if self.bubble:  # - K_ab K_bb^-1 K_ba over the (u, p) dofs
                 b, Ag = gr.b, L.take(A, gr)  # (k, j, d), (c,b,e,L,k,j)
-                Kub = np.einsum("kj,kjib,cbeLkj,kjL->kice", w, gr.G, Ag, b)
-                Kpb = np.einsum("kj,kjl,eLkj,kjL->kle", w, Np, Qg, b)
+                # K_ub[k, i, c, e] = sum_jb G_kjib (w A_cbeL b_L)_kj
+                Ab = np.einsum("cbeLkj,kjL->kjbce", Ag, w[:, :, None] * b)
+                Kub = np.swapaxes(gr.G, 1, 2).reshape(k, m, m * d) \
+                    @ Ab.reshape(k, m * d, d * d)
+                # K_pb[k, l, e] = sum_j Np_kjl (w Q_eL b_L)_kj
+                Kpb = NpT @ np.einsum("eLkj,kjL->kje", Qg, w[:, :, None] * b)
                 Ka = np.concatenate([Kub.reshape(k, m * d, d), Kpb], axis=1)
                 corr = -Ka @ np.linalg.solve(state["Kbb"][gr.families],
                                              np.swapaxes(Ka, 1, 2))
                 a = np.concatenate([udofs.reshape(k, m * d), pdofs], axis=1)
                 add(full, a[:, :, None], a[:, None, :], corr)
 
-        def coo(t):
-            return sp.coo_matrix((np.concatenate(t[2]), (
-                np.concatenate(t[0]), np.concatenate(t[1]))),
-                shape=(self.N, self.N)).tocsr()
-        H = coo(half)
+        if indices:
+            rows = np.concatenate(half[0] + half[1] + full[0])
+            cols = np.concatenate(half[1] + half[0] + full[1])
+            self._pattern = _Pattern(rows, cols, self.N)
+        hv = np.concatenate(half[2])
+        K = self._pattern.matrix(np.concatenate([hv, hv] + full[2]))
         Kuu.resize((self.N, self.N))
-        return Kuu + H + H.T + coo(full)
+        return Kuu + K

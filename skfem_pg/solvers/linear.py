@@ -52,19 +52,29 @@ def direct(A, b, ordering="auto", **kwargs):
     on 14k–80k dof 2-D elasticity systems (gmsh triangles, distorted
     grids; T1/Q1 and PG) the fastest of scipy's options or within 1.3x of
     it, while each SuperLU ordering alone is up to 27x slower on one of
-    them.  ``ordering="colamd"``: SuperLU's ``COLAMD``; on 3-D Cook
+    them.  A symmetric matrix is factorized with diagonal pivots
+    (SuperLU's ``SymmetricMode``), checked by its residual and refactorized
+    with partial pivoting if that is above :data:`PIVOT_CHECK` (condensed
+    mixed tangents, 3.4k unknowns: UnlP0 0.08 s against 0.9 s, Unl+P1C
+    0.5 s against 3.3 s; benchmarks/mixed_newton.py).  A saddle point
+    (zero diagonal entries: the pressure rows of IUnlP0, U2P1C) goes to
+    ``COLAMD`` instead (IUnlP0, 5k unknowns: 0.25 s against 9.6 s).
+    ``ordering="colamd"``: SuperLU's ``COLAMD``; on 3-D Cook
     tetrahedra (3.7k / 9.7k dof) 2.1x / 4.4x faster than ``rcm+mmd`` for
     O1 and 0.8x / 2.7x for PG.  Usable as ``fem.solve(A, b,
     solver=direct)``.
     """
     A = A.tocsr()
+    b = np.asarray(b, dtype=float)
     if ordering == "auto":
         ordering = "pardiso" if pardiso_available() else "rcm+mmd"
     if ordering == "pardiso":
         import pypardiso
-        x = pypardiso.spsolve(A, np.asarray(b, dtype=float))
+        x = pypardiso.spsolve(A, b)
         pypardiso.ps.free_memory(everything=True)
         return x
+    if ordering == "rcm+mmd" and np.any(A.diagonal() == 0.0):
+        ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
     if ordering == "colamd":
         return spl.spsolve(A.tocsc(), b, permc_spec="COLAMD")
     if ordering != "rcm+mmd":
@@ -72,9 +82,28 @@ def direct(A, b, ordering="auto", **kwargs):
                          "'colamd', got {!r}".format(ordering))
     from scipy.sparse.csgraph import reverse_cuthill_mckee
     p = reverse_cuthill_mckee(A, symmetric_mode=True)
-    x = np.empty_like(b, dtype=float)
-    x[p] = spl.spsolve(A[p][:, p].tocsc(), b[p], permc_spec="MMD_AT_PLUS_A")
+    Ap, bp = A[p][:, p].tocsc(), b[p]
+    x = np.empty_like(b)
+    if _symmetric(A):
+        xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                      options={"SymmetricMode": True}).solve(bp)
+        scale = np.abs(Ap).max() * max(np.abs(xp).max(), 1e-300)
+        if np.all(np.isfinite(xp)) and np.abs(Ap @ xp - bp).max() \
+                <= PIVOT_CHECK * max(scale, np.abs(bp).max()):
+            x[p] = xp
+            return x
+    x[p] = spl.spsolve(Ap, bp, permc_spec="MMD_AT_PLUS_A")
     return x
+
+
+#: largest relative residual ``|A x - b| / (|A| |x|)`` accepted from a
+#: factorization with diagonal pivots before partial pivoting is tried
+PIVOT_CHECK = 1e-11
+
+
+def _symmetric(A, tol=1e-12):
+    d = A - A.T
+    return d.nnz == 0 or np.abs(d.data).max() <= tol * np.abs(A.data).max()
 
 
 #: ``"auto"``: largest direct solve per spatial dimension (unknowns).
