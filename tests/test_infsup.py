@@ -72,3 +72,54 @@ def test_inf_sup_refuses_ppg():
     pb = pg.FamilyBasis(m, dim=2, method="PPG1")
     with pytest.raises(ValueError, match="PPG1"):
         infsup_pg(pb, np.arange(pb.N))
+
+
+def family_basis(m, shape="MTE1"):
+    """The thesis' inf-sup setting: horizon 2.51 spacings, no VC."""
+    p = pg.Particles.from_mesh(m)
+    return pg.FamilyBasis(p, pg.families.horizon(p, factor=2.51), dim=2,
+                          vc=None, shape=shape)
+
+
+def test_mixed_inf_sup_of_q1p0_is_the_fe_one():
+    from skfem_pg.analysis.infsup import infsup_mixed
+    from skfem_pg.formulations import MeanDilatation
+    m = square(4, 0.2)
+    b = fem.Basis(m, fem.ElementVector(fem.ElementQuad1()), intorder=2)
+    free = b.complement_dofs(b.get_dofs())
+    fe = infsup_fe(b, free, fem.Basis(m, fem.ElementQuad0(), intorder=2))
+    mixed = infsup_mixed(MeanDilatation(b, 1.0, 10.0), free)
+    assert abs(mixed["beta"] - fe["beta"]) <= 1e-10 * fe["beta"]
+    assert mixed["kpm"] == fe["kpm"]
+
+
+def test_mixed_pg_pairs():
+    """Measured on the clamped square (benchmarks/infsup_mixed.py):
+    Unl+P1C has no spurious pressure mode and the largest beta of the PBG
+    pairs (±0.3h, N = 4, 8: 0.31, 0.16); UnlP0 and U2P1C lie an order of
+    magnitude below (0.023 / 0.016, 0.035 / 0.023); U2P1's beta falls like
+    U2's (regular: 0.17, 0.043), its linear p, Theta reproduce the linear
+    divergence of a WTE2 family exactly (the thesis: U2P1 locks)."""
+    from skfem_pg.analysis.infsup import infsup_mixed
+    from skfem_pg.formulations import MeanDilatation, NodalPressure
+    beta = {}
+    for N in (4, 8):
+        for dist in (0.0, 0.3):
+            m = square(N, dist)
+            b = fem.Basis(m, fem.ElementVector(fem.ElementQuad1()))
+            free = b.complement_dofs(b.get_dofs())
+            mte, wte = family_basis(m), family_basis(m, "WTE2")
+            r = {"Unl+P1C": infsup_mixed(NodalPressure(mte, 1.0, 10.0),
+                                         free),
+                 "UnlP0": infsup_mixed(MeanDilatation(mte, 1.0, 10.0), free),
+                 "U2P1C": infsup_mixed(NodalPressure(wte, 1.0, 10.0,
+                                                     bubble=False), free),
+                 "U2P1": infsup_mixed(MeanDilatation(wte, 1.0, 10.0,
+                                                     order=1), free)}
+            assert r["Unl+P1C"]["kpm"] == 0
+            for k, v in r.items():
+                beta[k, N, dist] = v["beta"]
+    for N in (4, 8):
+        assert beta["Unl+P1C", N, 0.3] > 5 * beta["UnlP0", N, 0.3]
+        assert beta["Unl+P1C", N, 0.3] > 3 * beta["U2P1C", N, 0.3]
+    assert beta["U2P1", 8, 0.0] < 0.35 * beta["U2P1", 4, 0.0]

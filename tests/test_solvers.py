@@ -131,3 +131,74 @@ def test_fd_tangent_matches_consistent_tangent(beam):
     u1, _ = newton(Hyperelastic(b, m), f, D=D, verbose=False)
     u2, _ = newton(Hyperelastic(b, m, tangent="fd"), f, D=D, verbose=False)
     assert np.abs(u1 - u2).max() <= 1e-8 * np.abs(u1).max()
+
+
+def test_fixed_steps_neither_grow_nor_cut(beam):
+    """adaptive=False: exactly ``steps`` equal steps (no doubling after an
+    easy step), and a failing step raises at once (no halving)."""
+    mesh, b = beam
+    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    f = pg.traction(b, "right", [0.0, 0.05])
+    D = b.get_dofs("left")
+    _, hist = newton(model, f, D=D, steps=4, adaptive=False, verbose=False)
+    assert [h["load"] for h in hist] == [0.25, 0.5, 0.75, 1.0]
+    _, hist = newton(model, f, D=D, steps=4, verbose=False)  # adaptive
+    assert len(hist) < 4
+    f = pg.traction(b, "right", [0.0, 2.0])  # J <= 0 in one step
+    with pytest.raises(ConvergenceError) as err:
+        newton(model, f, D=D, steps=1, adaptive=False, verbose=False)
+    assert err.value.load == 0.0 and err.value.history == []
+
+
+def test_nearly_incompressible_small_load_converges_at_the_round_off_floor():
+    """K = 2e7 mu (the nearly incompressible Cook membrane): the residual
+    stalls at a floor set by K eps, not by the load (5e-8 with a load of
+    1e-5: 2 % of the first residual), so Newton stops on the increments'
+    energy, and the displacement is the linear solution's."""
+    G, LAM_ = 0.375, 7.5e6
+    mesh = pg.meshing.distort(pg.meshing.cook_membrane(8), 0.3, seed=8)
+    mesh = mesh.with_boundaries({"left": lambda x: np.isclose(x[0], 0.0),
+                                 "right": lambda x: np.isclose(x[0], 48.0)})
+    basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad2()))
+    load = 1e-5
+    f = fem.asm(fem.LinearForm(lambda v, w: load / 16 * v[1]),
+                basis.boundary("right"))
+    D = basis.get_dofs("left").all()
+    model = Hyperelastic(basis, mat.NeoHookeIsoVol(G, LAM_ + 2 * G / 3))
+    u, hist = newton(model, f, D=D, verbose=False)
+    assert len(hist) == 1  # no cut step
+    assert hist[0]["reason"] == "round-off floor"
+    assert hist[0]["residuals"][-1] > 1e-3 * hist[0]["residuals"][0]
+    ul = fem.solve(*fem.condense(
+        linear_elasticity(LAM_, G).assemble(basis), f, D=D))
+    assert np.abs(u - ul).max() <= 1e-4 * np.abs(ul).max()
+
+
+@pytest.mark.parametrize("kind", ["symmetric", "saddle", "needs pivoting",
+                                  "nonsymmetric"])
+def test_direct_solver_paths(kind):
+    """pg.solvers.direct: diagonal pivots for symmetric matrices (checked
+    by the residual, refactorized with partial pivoting when they fail),
+    COLAMD for saddle points, partial pivoting otherwise: all exact."""
+    import scipy.sparse as sp
+    rng = np.random.default_rng(3)
+    n = 60
+    A = sp.random(n, n, density=0.1, random_state=rng) + 10 * sp.eye(n)
+    if kind != "nonsymmetric":
+        A = A + A.T
+    if kind == "saddle":
+        B = sp.random(10, n, density=0.3, random_state=rng)
+        A = sp.bmat([[A, B.T], [B, None]])
+    if kind == "needs pivoting":  # tiny diagonal pivots, large off-diagonal
+        A = sp.bmat([[sp.eye(n) * 1e-14, sp.eye(n)], [sp.eye(n), A]])
+    A = A.tocsr()
+    b = rng.standard_normal(A.shape[0])
+    from unittest import mock
+    from skfem_pg.solvers import linear
+    spsolve = linear.spl.spsolve
+    with mock.patch.object(linear.spl, "spsolve",
+                           side_effect=spsolve) as partial:
+        x = pg.solvers.direct(A, b)
+    assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
+    # partial pivoting (spsolve) only where diagonal pivots cannot do
+    assert partial.called == (kind != "symmetric")

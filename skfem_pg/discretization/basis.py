@@ -256,9 +256,13 @@ class FamilyBasis(AbstractBasis):
 
         t0 = time.perf_counter()
         if families is None and shape == "WTE2":
+            # twice the d + d(d+1)/2 quadratic moments, plus the master:
+            # with fewer, corner families of graded meshes (Cook's (48,
+            # 60) at 7 members) give a singular WTE2 moment matrix
             d = particles.dim
             families = families_mod.horizon(
-                particles, factor=2.51, min_size=2 + d + d * (d + 1) // 2)
+                particles, factor=2.51,
+                min_size=1 + 2 * (d + d * (d + 1) // 2))
         elif families is None:
             families = (families_mod.from_mesh(particles)
                         if particles.mesh is not None

@@ -56,7 +56,7 @@ def _condensed_solver(kind, basis, I, extra_fields=False):
 
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           predictor=True, verbose=True):
+           adaptive=True, predictor=True, verbose=True):
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
@@ -89,13 +89,21 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         last increment :math:`|\Delta x\cdot r|` below ``tol²`` times
         that of the first (a measure in units of work, whatever the
         fields: with pressures and dilatations as unknowns the residual
-        norm mixes units and stalls at a round-off floor set by the bulk
-        modulus).
+        norm mixes units); or, once the residual stops decreasing (its
+        round-off floor, set by the bulk modulus and not by the load),
+        that energy below ``ROUNDOFF_ENERGY · tol`` times the first
+        (the history's ``reason`` then says "round-off floor").
     solver
         Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``
         (:func:`linear_solver` on the free dofs), or a callable ``(A, b)
         -> x`` for the condensed systems, e.g. a :func:`linear_solver`
         built once and shared by several calls.
+    adaptive
+        ``True``: a step that converges in at most 4 iterations doubles
+        the next one, a failed step is halved (down to ``min_step``).
+        ``False``: ``steps`` equal steps, and a failed one raises
+        :class:`ConvergenceError` at once (robustness studies: the largest
+        step that converges).
     predictor
         Start each load step from the linear extrapolation of the last two
         converged states (secant predictor) instead of the last one; a
@@ -106,8 +114,9 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     x, history
         ``x``: all unknowns (``model.N``; the displacements are
         ``x[:model.n_u]``).  ``history`` is a list of dicts per converged
-        step (load factor, residual norms per iteration, minimum J,
-        seconds).
+        step (load factor, residual norms per iteration, the increments'
+        energies ``|Δx·r|``, minimum J, the criterion's note in
+        ``reason``, seconds).
 
     """
     basis = model.basis
@@ -160,11 +169,11 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
-            if len(info["residuals"]) <= 5:
+            if adaptive and len(info["residuals"]) <= 5:
                 dlam = min(2 * dlam, 1.0)
             continue
         dlam /= 2
-        if dlam < min_step:
+        if dlam < min_step or not adaptive:
             raise ConvergenceError(
                 "Newton failed at load factor {:.6g} ({}); the step fell "
                 "below min_step = {:.3g} after reaching load {:.6g}".format(
@@ -191,6 +200,13 @@ def _padded(v, n_u, N, what, rest=None):
     return v.copy()
 
 
+#: a residual that stops decreasing is at its round-off floor (e.g. K·eps
+#: of a nearly incompressible material: 5e-8 on the Cook membrane with
+#: K = 2e7 mu, whatever the load) once the last increment did less than
+#: ``ROUNDOFF_ENERGY * tol`` of the step's first increment's work
+ROUNDOFF_ENERGY = 1e-3
+
+
 def _small_increment(model, du, u):
     """Every field's Newton increment below 1e-10 of its magnitude."""
     blocks = getattr(model, "blocks", [("u", slice(None))])
@@ -210,11 +226,11 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
     du_D = u_DD - u[Dd]
     pending = bool(np.any(du_D != 0))
     res = []
-    info = {"residuals": res, "min_J": np.nan, "reason": "",
-            "t_assemble": 0.0, "t_linear": 0.0}
+    energy = []  # |du · rhs| of each solve
+    info = {"residuals": res, "energies": energy, "min_J": np.nan,
+            "reason": "", "t_assemble": 0.0, "t_linear": 0.0}
     ref = None
     small = False
-    energy = []  # |du · rhs| of each solve
     for it in range(maxiter + 1):
         t0 = time.perf_counter()
         state = model.state(u)
@@ -234,6 +250,10 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
                 ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
             if rn <= tol * ref or small or (
                     len(energy) > 1 and energy[-1] <= tol ** 2 * energy[0]):
+                return True, u, info
+            if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
+                    and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
+                info["reason"] = "round-off floor"  # converged
                 return True, u, info
             if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
                 info["reason"] = "diverging"
