@@ -218,9 +218,19 @@ class NodalPressure(Hyperelastic):
 
     def _solve_bubble(self, Fu, p):
         """The bubble amplitudes ``(d, n_f)`` with :math:`R_b = 0`, by a
-        batched Newton from the last ones; also :math:`K_{bb}`."""
+        batched Newton from the last ones (and, should that fail — e.g.
+        the last ones belong to another run —, from zero); also
+        :math:`K_{bb}`."""
+        for start in (self._ub, np.zeros_like(self._ub)):
+            out = self._bubble_newton(Fu, p, start.copy())
+            if out is not None:
+                self._ub = out[1]
+                return out
+        # no convergence (e.g. J <= 0 inside a family): let Newton cut
+        return np.full_like(Fu, np.nan), self._ub, None
+
+    def _bubble_newton(self, Fu, p, ub):
         E, b = self.elements, self._b
-        ub = self._ub.copy()
         bn = np.abs(b).max()
         for it in range(BUBBLE_MAXITER):
             F = Fu + E.spread(ub)[:, None] * b[None]
@@ -229,17 +239,16 @@ class NodalPressure(Hyperelastic):
             Rb = E.sum(np.einsum("iJ...,J...->i...", P, b))  # (d, nf)
             Kbb = E.sum(np.einsum("iJkL...,J...,L...->ik...", A, b, b))
             Kbb = np.moveaxis(Kbb, -1, 0)  # (nf, d, d)
-            dub = -np.linalg.solve(Kbb, Rb.T[..., None])[..., 0].T
-            ub += dub
+            try:
+                dub = -np.linalg.solve(Kbb, Rb.T[..., None])[..., 0].T
+            except np.linalg.LinAlgError:  # a family's K_bb is singular
+                return None
+            ub = ub + dub
             if not np.all(np.isfinite(ub)):
-                break
+                return None
             if np.abs(dub).max() * bn <= BUBBLE_TOL:
-                F = Fu + E.spread(ub)[:, None] * b[None]
-                self._ub = ub
-                return F, ub, Kbb
-        # no convergence (e.g. J <= 0 inside a family): let Newton cut
-        nan = np.full_like(Fu, np.nan)
-        return nan, ub, None
+                return Fu + E.spread(ub)[:, None] * b[None], ub, Kbb
+        return None
 
     def min_J(self, state):
         if not np.all(np.isfinite(state["F"])):
