@@ -13,12 +13,14 @@ is then of order 1e-5).  Reference: Q1P0 on the regular 256 x 256 mesh
 
 Node sets: the n x n Cook quadrilaterals, interior nodes moved by ±0.3h
 (T1 on the same nodes, each quad split in two).  Methods: Q1, T1, Q1P0,
-VCPBG Unl, VCPBG UnlP0, VCPBG Unl+P1C, VCPBG U2P1, VCPBG U2P1C.
+VCPBG Unl, VCPBG UnlP0, VCPBG Unl+P1C, VCPBG U2P1, VCPBG U2P1C (the
+thesis' default VC boundary variant sn) and VCBCPBG V5m UnlP0, Unl+P1C
+(the package's min-norm variant).
 
 Prints v, its error against the reference and against 16.4326, Newton
 iterations and wall time; writes out/cook_incompressible.png (error
-against wall time) and out/cook_incompressible.vtu (VCPBG Unl+P1C on the
-finest set: displacement, stresses and the nodal pressure).
+against wall time) and out/cook_incompressible.vtu (VCBCPBG V5m Unl+P1C
+on the finest set: displacement, stresses and the nodal pressure).
 
     python demos/cook_incompressible.py [--sizes 8 16 32] [--full]
 """
@@ -43,9 +45,11 @@ POINT = (48.0, 52.0)
 PUBLISHED = 16.4326
 
 METHODS = ["Q1", "T1", "Q1P0", "VCPBG Unl", "VCPBG UnlP0",
-           "VCPBG Unl+P1C", "VCPBG U2P1", "VCPBG U2P1C"]
+           "VCBCPBG V5m UnlP0", "VCPBG Unl+P1C", "VCBCPBG V5m Unl+P1C",
+           "VCPBG U2P1", "VCPBG U2P1C"]
 STYLES = {"Q1": "C7:s", "T1": "k--o", "Q1P0": "k-s", "VCPBG Unl": "C2-v",
-          "VCPBG UnlP0": "C1-^", "VCPBG Unl+P1C": "C0-D",
+          "VCPBG UnlP0": "C1-^", "VCBCPBG V5m UnlP0": "C1:^",
+          "VCPBG Unl+P1C": "C0-D", "VCBCPBG V5m Unl+P1C": "C0:D",
           "VCPBG U2P1": "C3:x", "VCPBG U2P1C": "C4-.+"}
 
 
@@ -107,7 +111,7 @@ def main(sizes=(8, 16, 32), results=None, out=None):
             print("{n:4d} {nodes:6d} {method:16s} v = {v:9.5f}  error "
                   "{err:8.2e}  vs published {pub:+8.2%}  Newton {newton:2d}"
                   "  {t:6.2f} s".format(t=wall_time(row), **row), flush=True)
-            if name == "VCPBG Unl+P1C":
+            if name == "VCBCPBG V5m Unl+P1C":
                 last = r
     print_time_to_target(rows, METHODS, 0.01, "error of v(48, 52)")
     table = markdown_table(

@@ -104,42 +104,39 @@ def runs(name, mesh, twist):
     return run, last
 
 
-def largest(ok, lo, hi, limit):
-    """Largest integer in [lo, limit] with ``ok`` by doubling from ``lo``
-    (known good, or 0) then bisection; ``hi`` a known failure or None."""
-    while hi is None:
-        trial = min(2 * max(lo, 1), limit)
-        if ok(trial):
-            lo = trial
-            if trial == limit:
-                return lo
-        else:
-            hi = trial
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
+def bisect(ok, good, bad):
+    """The integer next to ``bad`` on ``good``'s side with ``ok`` (``ok
+    (good)`` holds, ``ok(bad)`` does not; either may be the larger)."""
+    while abs(good - bad) > 1:
+        mid = (good + bad) // 2
         if ok(mid):
-            lo = mid
+            good = mid
         else:
-            hi = mid
+            bad = mid
+    return good
+
+
+def largest(ok, lo, limit):
+    """Largest integer in [lo, limit] with ``ok`` (``ok(lo)`` holds) by
+    doubling from ``lo``, then bisection."""
+    while lo < limit:
+        trial = min(2 * lo, limit)
+        if not ok(trial):
+            return bisect(ok, lo, trial)
+        lo = trial
     return lo
 
 
 def smallest(ok, start, limit):
     """Fewest steps in [start, limit] with ``ok``, doubling then
     bisection; None if even ``limit`` fails."""
-    lo, hi = start - 1, start
-    while not ok(hi):
-        lo = hi
-        if hi >= limit:
+    bad, good = start - 1, start
+    while not ok(good):
+        bad = good
+        if good >= limit:
             return None
-        hi = min(2 * hi, limit)
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if ok(mid):
-            hi = mid
-        else:
-            lo = mid
-    return hi
+        good = min(2 * good, limit)
+    return bisect(ok, good, bad)
 
 
 def study(label, mesh, max_steps=180):
@@ -151,7 +148,7 @@ def study(label, mesh, max_steps=180):
         print("{:12s} not built: {}".format(label, err))
         return None
     first = run(1, 1)
-    step = largest(lambda a: run(a, 1), 1, None, 360) if first else 0
+    step = largest(lambda a: run(a, 1), 1, 360) if first else 0
     steps = smallest(lambda m: run(360, m), math.ceil(360 / step),
                      max_steps) if step else None
     row = dict(method=label, solved=SOLVED[label], step=step, steps=steps,

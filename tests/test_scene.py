@@ -97,3 +97,31 @@ def test_callables_enter_the_cache_key_by_content():
     c = Scene("k", m, mat.NeoHooke(2.0, 1.0),
               prescribed={"left": lambda x, t: 0 * x})
     assert a.fingerprint() == b.fingerprint() != c.fingerprint()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_sliding_boundaries_pass_the_patch_test_or_are_refused(dim):
+    """A block on a roller bottom and a symmetry plane under a uniform
+    pressure: the strain is homogeneous.  The min-norm and p VC boundary
+    variants reproduce it to round-off; s / sn (the thesis' default of
+    'VCPBG' names) would not (3-D: u_z 25 % off) and are refused."""
+    shape = (4, 2) if dim == 2 else (3, 3, 2)
+    cls = fem.MeshQuad if dim == 2 else fem.MeshHex
+    mesh = cls.init_tensor(*[np.linspace(0, 1, k + 1) for k in shape])
+    mesh = mesh.with_boundaries({
+        "x0": lambda x: np.isclose(x[0], 0.0),
+        "bottom": lambda x: np.isclose(x[-1], 0.0),
+        "top": lambda x: np.isclose(x[-1], 1.0)})
+    t = np.zeros(dim)
+    t[-1] = -0.01
+    scene = Scene("rollers", mesh, mat.LinearElastic(1.0, 1.0),
+                  prescribed={"x0": {0: 0.0}, "bottom": {dim - 1: 0.0}},
+                  tractions={"top": t})
+    for name in ("VCBCPBG V5m Unl", "VCBCPBG V5p Unl"):
+        u = scene.solve(name).u.reshape(-1, dim).T
+        for c in (0, dim - 1):  # u_c / x_c is one constant
+            X = mesh.p[c]
+            ratio = u[c, X > 0] / X[X > 0]
+            assert ratio.max() - ratio.min() <= 1e-10 * abs(ratio).max()
+    with pytest.raises(ValueError, match="sliding"):
+        scene.solve("VCPBG Unl")

@@ -457,3 +457,30 @@ def assemble(form, basis, vbasis=None, **kwargs):
     if vbasis is basis:
         return _generic(form, basis, **kwargs)
     return _generic(form, basis, vbasis, **kwargs)
+
+
+class FixedPattern:
+    """A fixed sparsity pattern of COO entries ``(rows, cols)`` (``N × N``):
+    the CSR structure is found once, then :meth:`matrix` sums each new set
+    of values into it by one ``bincount`` — for tangents whose local
+    blocks do not fit a form (the global p / Theta blocks of
+    :class:`~skfem_pg.formulations.NodalPressure`, the master-point
+    volumetric term of PPG UnlP0)."""
+
+    def __init__(self, rows, cols, N):
+        A = sp.coo_matrix((np.arange(1, len(rows) + 1, dtype=float),
+                           (rows, cols)), shape=(N, N)).tocsr()
+        A.sum_duplicates()
+        A.sort_indices()
+        self.indptr, self.indices = A.indptr, A.indices
+        # position of every COO entry in the CSR data
+        key = rows.astype(np.int64) * N + cols
+        csr_rows = np.repeat(np.arange(N), np.diff(A.indptr))
+        csr_key = csr_rows.astype(np.int64) * N + A.indices
+        self.pos = np.searchsorted(csr_key, key)
+        self.N, self.nnz = N, len(A.indices)
+
+    def matrix(self, values):
+        data = np.bincount(self.pos, values, minlength=self.nnz)
+        return sp.csr_matrix((data, self.indices, self.indptr),
+                             shape=(self.N, self.N))

@@ -3,29 +3,34 @@ material make into the residual and tangent that the solvers drive.
 The model interface (fields, residual, tangent) is described in
 :mod:`~skfem_pg.formulations.displacement`.
 
-=================  ========================================================
-``linear``         linear elasticity as a plain scikit-fem form
-``displacement``   :class:`Hyperelastic`: the displacement formulation (PG
-                   U1/Unl/U2, FE T1/Q1/O1/H1/...)
-``dilatation``     :class:`MeanDilatation`: condensed polynomial pressure
-                   and dilatation per element — FE Q1P0/H1P0, PBG UnlP0,
-                   U2P1
-``incompressible`` :class:`IncompressibleP0`: nu = 0.5, one pressure per
-                   element as a global unknown — PBG IUnlP0, FE Q1P0/H1P0
-``nodal``          :class:`NodalPressure`: nodal p and Theta as global
-                   unknowns — PBG U2P1C, Unl+P1C (with a condensed bubble)
-``by_name``        the model of a Table 7.1 formulation token
-``tangents``       finite-difference tangent of family forces
-=================  ========================================================
+=====================  ====================================================
+``linear``             linear elasticity as a plain scikit-fem form
+``displacement``       :class:`Hyperelastic`: the displacement formulation
+                       (PG U1/Unl/U2, FE T1/Q1/O1/H1/...)
+``dilatation``         :class:`MeanDilatation`: condensed polynomial
+                       pressure and dilatation per element — FE
+                       Q1P0/H1P0, PBG UnlP0, U2P1
+``master_dilatation``  :class:`MasterDilatation`: PPG UnlP0, the
+                       volumetric part once per particle, at the master
+``incompressible``     :class:`IncompressibleP0`: nu = 0.5, one pressure
+                       per element as a global unknown — PBG IUnlP0, FE
+                       Q1P0/H1P0
+``nodal``              :class:`NodalPressure`: nodal p and Theta as global
+                       unknowns — PBG U2P1C, Unl+P1C (a condensed bubble)
+``by_name``            the model of a Table 7.1 formulation token
+``tangents``           finite-difference tangent of family forces
+=====================  ====================================================
 """
 from .linear import linear_elasticity
 from .displacement import Hyperelastic, internal_force, material_tangent
 from .dilatation import MeanDilatation
 from .incompressible import IncompressibleP0
+from .master_dilatation import MasterDilatation
 from .nodal import NodalPressure
 from .by_name import model_for
 from .tangents import fd_tangent
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
-           "material_tangent", "MeanDilatation", "IncompressibleP0",
+           "material_tangent", "MeanDilatation", "MasterDilatation",
+           "IncompressibleP0",
            "NodalPressure", "model_for", "fd_tangent"]

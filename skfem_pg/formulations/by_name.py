@@ -6,7 +6,8 @@ token                   model
 ======================  ===================================================
 ``Unl``, ``U1``, ``U2``  :class:`~.displacement.Hyperelastic` (PG)
 ``T1`` ... ``H2``       :class:`~.displacement.Hyperelastic` (FE)
-``UnlP0``               :class:`~.dilatation.MeanDilatation` (PBG)
+``UnlP0``               :class:`~.dilatation.MeanDilatation` (PBG),
+                        :class:`~.master_dilatation.MasterDilatation` (PPG)
 ``U2P1``                :class:`~.dilatation.MeanDilatation` of order 1
                         (PBG, WTE2 basis)
 ``Q1P0``, ``H1P0``      :class:`~.dilatation.MeanDilatation`, or with an
@@ -26,6 +27,7 @@ import numpy as np
 from .dilatation import MeanDilatation
 from .displacement import Hyperelastic
 from .incompressible import IncompressibleP0
+from .master_dilatation import MasterDilatation
 from .nodal import NodalPressure
 
 #: built formulation tokens beyond the displacement ones
@@ -62,5 +64,7 @@ def model_for(formulation, basis, material, tangent="consistent"):
         if formulation == "UnlP0" and _incompressible(material):
             raise ValueError("UnlP0 condenses the pressure with a finite "
                              "bulk modulus; for nu = 0.5 use IUnlP0")
+        if formulation == "UnlP0" and getattr(basis, "is_petrov", False):
+            return MasterDilatation.of(basis, material)
         return MIXED[formulation].of(basis, material)
     return Hyperelastic(basis, material, tangent=tangent)

@@ -39,7 +39,7 @@ volumetric force (6.8), :math:`P_{vol} = J p F^{-T}`) and the tangent
 a term of rank ``q`` (1 or d + 1) per element
 (:class:`~skfem_pg.discretization.elementwise.Elements`, batched over size
 groups).  PPG UnlP0 (the master evaluation :math:`\Theta^k = J^{kk}`) is
-not built.
+:mod:`.master_dilatation`.
 """
 import numpy as np
 
@@ -73,9 +73,9 @@ class MeanDilatation(Hyperelastic):
     def __init__(self, basis, mu, K, order=0):
         if getattr(basis, "is_petrov", False):
             raise NotImplementedError(
-                "UnlP0 on a Petrov–Galerkin basis (PPG UnlP0: the "
-                "dilatation at the master, Theta^k = J^kk) is not built; "
-                "use a PBG basis")
+                "MeanDilatation integrates over the family (PBG); PPG UnlP0 "
+                "(the dilatation at the master, Theta^k = J^kk) is "
+                "MasterDilatation")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
         self.order = int(order)

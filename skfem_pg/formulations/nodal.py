@@ -45,7 +45,7 @@ thesis notes.
 import numpy as np
 import scipy.sparse as sp
 
-from ..discretization.assembly import assemble
+from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
 from ..errors import ParticleError
 from ..materials import NeoHookeIsoVol, inverse_and_det
@@ -74,29 +74,6 @@ class _Group:
         Vm = V[g.members]
         Xc = (X * Vm).sum(axis=-1) / Vm.sum(axis=-1)  # (d, k)
         self.b = np.moveaxis(X - Xc[:, :, None], 0, -1)  # (k, j, d)
-
-
-class _Pattern:
-    """A fixed sparsity pattern of COO entries ``(rows, cols)``: the CSR
-    structure once, then each new set of values summed into it by one
-    ``bincount``."""
-
-    def __init__(self, rows, cols, N):
-        A = sp.coo_matrix((np.arange(1, len(rows) + 1, dtype=float),
-                           (rows, cols)), shape=(N, N)).tocsr()
-        A.sum_duplicates()
-        self.indptr, self.indices = A.indptr, A.indices
-        # position of every COO entry in the CSR data
-        key = rows.astype(np.int64) * N + cols
-        csr_rows = np.repeat(np.arange(N), np.diff(A.indptr))
-        csr_key = csr_rows.astype(np.int64) * N + A.indices
-        self.pos = np.searchsorted(csr_key, key)
-        self.N, self.nnz = N, len(A.indices)
-
-    def matrix(self, values):
-        data = np.bincount(self.pos, values, minlength=self.nnz)
-        return sp.csr_matrix((data, self.indices, self.indptr),
-                             shape=(self.N, self.N))
 
 
 class NodalPressure(Hyperelastic):
@@ -335,7 +312,7 @@ class NodalPressure(Hyperelastic):
         if indices:
             rows = np.concatenate(half[0] + half[1] + full[0])
             cols = np.concatenate(half[1] + half[0] + full[1])
-            self._pattern = _Pattern(rows, cols, self.N)
+            self._pattern = FixedPattern(rows, cols, self.N)
         hv = np.concatenate(half[2])
         K = self._pattern.matrix(np.concatenate([hv, hv] + full[2]))
         Kuu.resize((self.N, self.N))

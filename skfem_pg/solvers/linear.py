@@ -85,8 +85,12 @@ def direct(A, b, ordering="auto", **kwargs):
     Ap, bp = A[p][:, p].tocsc(), b[p]
     x = np.empty_like(b)
     if _symmetric(A):
-        xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                      options={"SymmetricMode": True}).solve(bp)
+        try:
+            xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A",
+                          diag_pivot_thresh=0.0,
+                          options={"SymmetricMode": True}).solve(bp)
+        except RuntimeError:  # a zero diagonal pivot: pivot partially
+            xp = np.full_like(bp, np.nan)
         scale = np.abs(Ap).max() * max(np.abs(xp).max(), 1e-300)
         if np.all(np.isfinite(xp)) and np.abs(Ap @ xp - bp).max() \
                 <= PIVOT_CHECK * max(scale, np.abs(bp).max()):

@@ -174,10 +174,13 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             continue
         dlam /= 2
         if dlam < min_step or not adaptive:
+            why = ("fixed steps of {:.3g}".format(2 * dlam) if not adaptive
+                   else "the step fell below min_step = {:.3g}".format(
+                       min_step))
             raise ConvergenceError(
-                "Newton failed at load factor {:.6g} ({}); the step fell "
-                "below min_step = {:.3g} after reaching load {:.6g}".format(
-                    target, info["reason"], min_step, lam),
+                "Newton failed at load factor {:.6g} ({}); {} after "
+                "reaching load {:.6g}".format(target, info["reason"], why,
+                                              lam),
                 load=lam, u=u, history=history)
     return u, history
 

@@ -1,0 +1,162 @@
+r"""PPG UnlP0 (thesis (6.2), 6.2.1): the volumetric energy evaluated once
+per family, at its master.
+
+In PPG (4.21) every bond carries the stress of the trial deformation
+gradient :math:`F^{jk}` at :math:`X^k` computed in family :math:`j`, tested
+with the derivative at the master (:mod:`skfem_pg.discretization.petrov`).
+UnlP0 keeps that for the isochoric part and takes the volumetric part once
+per particle, from the master's own :math:`F^{kk}` ((6.2); condensed:
+:math:`\Theta^k = J^{kk}`, :math:`p^k = U'(J^{kk})`, a selective
+underintegration of (6.3)):
+
+.. math::
+
+    \delta W = \sum_k V^k \sum_{j\in H^k} \big[P_{iso}(F^{jk})
+        + P_{vol}(F^{kk})\big] : \big((\delta u^j - \delta u^k)\otimes
+        G_t^{kkj}\big), \qquad P_{vol} = p\,JF^{-T},\quad
+        U(J) = \tfrac K4 (J^2 - 1 - 2\ln J).
+
+With the test vectors :math:`S^k_i` of particle :math:`k`
+(:math:`S^k_j = G_t^{kkj}`, :math:`S^k_k = -\sum_j G_t^{kkj}`, on the
+members of :math:`H^k`) the volumetric residual is
+:math:`V^k P_{vol}^k\,S^k_i` and its tangent the one-point block
+
+.. math::
+
+    K^k_{(ic)(le)} = V^k\, S^k_{ib}\,\mathbb A_{vol,cbeL}(F^{kk})\,
+        G^{kkl}_L ,\qquad \mathbb A_{vol} = U''\,(JF^{-T})\otimes(JF^{-T})
+        + p\,\partial_F(JF^{-T}),
+
+non-symmetric like every PPG tangent.  The pressure is one value per
+particle (``fields``), which the volumetric underintegration lets
+oscillate (thesis 7.2.5: PPG UnlP0 formally passes the inf-sup test).
+"""
+import numpy as np
+
+from ..discretization.assembly import FixedPattern, assemble
+from ..discretization.petrov import reverse_slots
+from ..errors import ParticleError
+from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..threads import kernel
+from .dilatation import _d_JFinvT
+from .displacement import Hyperelastic, material_tangent
+
+
+class MasterDilatation(Hyperelastic):
+    """PPG UnlP0 on a Petrov–Galerkin :class:`~skfem_pg.FamilyBasis`
+    (``method="PPG1"``) whose families are mastered by every particle;
+    iso/vol neo-Hooke with shear modulus ``mu`` and bulk modulus ``K``.
+
+    ``fields(u)``: the pressure ``p`` and dilatation ``Theta`` (= J at the
+    master) per particle."""
+
+    def __init__(self, basis, mu, K):
+        if not getattr(basis, "is_petrov", False) or basis.method != "PPG1":
+            raise NotImplementedError(
+                "the master-point dilatation is PPG UnlP0 on a PPG1 basis "
+                "(got {}); PBG UnlP0 is MeanDilatation".format(
+                    getattr(basis, "method", type(basis).__name__)))
+        super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
+        self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
+        p, fam = basis.particles, basis.families
+        if len(fam.masters) != p.n:
+            i = int(np.setdiff1d(np.arange(p.n), fam.masters)[0])
+            raise ParticleError(
+                "particle {} at {} masters no family: PPG UnlP0 needs one "
+                "at every particle".format(i, tuple(p.x[:, i])))
+        mem, mask = fam.padded()
+        self.mem = np.where(mask, mem, mem[:, :1])  # pads -> the master
+        self.V = p.volumes[fam.masters]  # V^k per family
+        self._G0 = basis._G[:, 0] * mask[:, :, None]  # trial at the master
+        # S^k: sum over the bonds (f, q) with mem[f, q] = k of the test
+        # derivatives, gathered on family k's slots
+        T = basis.test.G  # (nf, m, m, d): T[f, q, 0] = G_t^{kkf}
+        index = np.full(p.n, -1)
+        index[fam.masters] = np.arange(len(fam.masters))
+        rev = reverse_slots(fam)
+        nf, m, d = mask.shape + (p.dim,)
+        S = np.zeros((nf, m, d))
+        f, q = np.nonzero(mask & (np.arange(m) > 0))
+        k = index[mem[f, q]]
+        np.add.at(S, (k, rev[f, q]), T[f, q, 0])
+        np.add.at(S, (k, np.zeros_like(k)), T[f, q, q])
+        self.S = S
+        self._pattern = None
+
+    @classmethod
+    def of(cls, basis, material):
+        """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
+        if not isinstance(material, NeoHookeIsoVol) \
+                or not np.isfinite(material.K):
+            raise ValueError("PPG UnlP0 needs the iso/vol neo-Hooke "
+                             "material with a finite bulk modulus, got "
+                             "{!r}".format(material))
+        return cls(basis, material.mu, material.K)
+
+    def _master(self, u):
+        """:math:`F^{kk}` per family, ``(d, d, nf)``."""
+        d = self.S.shape[-1]
+        U = u.reshape(-1, d)[self.mem]  # (nf, m, d)
+        return np.eye(d)[:, :, None] + np.einsum("kic,kib->cbk", U,
+                                                 self._G0)
+
+    def _volumetric(self, Fm):
+        Finv, J = inverse_and_det(Fm)
+        K = self.K
+        p = 0.5 * K * (J - 1.0 / J)
+        return Finv, J, p, p * J * np.swapaxes(Finv, 0, 1)
+
+    @kernel
+    def state(self, u):
+        s = super().state(u)
+        Fm = self._master(u)
+        Finv, J, p, Pv = self._volumetric(Fm)
+        s.update(Fm=Fm, Finv_m=Finv, J_m=J, p=p, P_vol=Pv)
+        return s
+
+    def min_J(self, state):
+        return float(min(super().min_J(state), state["J_m"].min()))
+
+    def energy(self, state):
+        J = state["J_m"]
+        U = 0.25 * self.K * (J ** 2 - 1 - 2 * np.log(J))
+        return super().energy(state) + float(np.sum(self.V * U))
+
+    def fields(self, x):
+        s = self.state(np.asarray(x, dtype=float))
+        n = self.basis.particles.n
+        p, Th = np.empty(n), np.empty(n)
+        masters = self.basis.families.masters
+        p[masters], Th[masters] = s["p"], s["J_m"]
+        return {"p": p, "Theta": Th}
+
+    @kernel
+    def internal_force(self, state):
+        r = super().internal_force(state)
+        d = self.S.shape[-1]
+        # V^k P_vol^k S^k_i on the members of family k
+        loc = np.einsum("k,cbk,kib->kic", self.V, state["P_vol"], self.S)
+        return r + np.bincount(
+            (d * self.mem[:, :, None] + np.arange(d)).ravel(), loc.ravel(),
+            minlength=self.n_u)
+
+    @kernel
+    def tangent(self, state):
+        K = assemble(material_tangent, self.basis,
+                     A=self.material.tangent(state["F"]))
+        Finv, J, p = state["Finv_m"], state["J_m"], state["p"]
+        Q = J * np.swapaxes(Finv, 0, 1)
+        Upp = 0.5 * self.K * (1.0 + 1.0 / J ** 2)
+        A = Upp * Q[:, :, None, None] * Q[None, None] + p * _d_JFinvT(J,
+                                                                    Finv)
+        SA = np.einsum("k,kib,cbeLk->kiceL", self.V, self.S, A)
+        nf, m, d = self.S.shape
+        loc = np.einsum("kiceL,klL->kicle", SA, self._G0)
+        if self._pattern is None:
+            dofs = (d * self.mem[:, :, None] + np.arange(d)).reshape(nf,
+                                                                     m * d)
+            rows = np.broadcast_to(dofs[:, :, None], (nf, m * d, m * d))
+            cols = np.broadcast_to(dofs[:, None, :], (nf, m * d, m * d))
+            self._pattern = FixedPattern(rows.ravel(), cols.ravel(),
+                                         self.n_u)
+        return K + self._pattern.matrix(loc.ravel())
