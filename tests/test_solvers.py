@@ -202,3 +202,30 @@ def test_direct_solver_paths(kind):
     assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
     # partial pivoting (spsolve) only where diagonal pivots cannot do
     assert partial.called == (kind != "symmetric")
+
+
+def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
+    """A step clipped at the end of the load (target 1) that fails is
+    halved from its actual size, not from the unclipped one (which tried
+    the same step again)."""
+    from skfem_pg.solvers import static
+    mesh, b = beam
+    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    tried, done = [], [0.0]  # (from, to, converged), last converged load
+    step = static._newton_step
+
+    def fails_above(model, u, lam, *args):
+        if lam == 1.0 and lam - done[0] > 0.05:  # the last bit is hard
+            tried.append((done[0], lam, False))
+            return False, u, {"residuals": [1.0], "reason": "test",
+                              "min_J": 1.0}
+        ok, u, info = step(model, u, lam, *args)
+        tried.append((done[0], lam, ok))
+        done[0] = lam if ok else done[0]
+        return ok, u, info
+    monkeypatch.setattr(static, "_newton_step", fails_above)
+    f = pg.traction(b, "right", [0.0, 0.01])
+    newton(model, f, D=b.get_dofs("left"), predictor=False, verbose=False)
+    attempts = [(s, t) for s, t, _ in tried]
+    assert all(a != b for a, b in zip(attempts, attempts[1:]))
+    assert tried[-1][1:] == (1.0, True)

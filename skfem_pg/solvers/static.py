@@ -172,7 +172,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             if adaptive and len(info["residuals"]) <= 5:
                 dlam = min(2 * dlam, 1.0)
             continue
-        dlam /= 2
+        dlam = (target - lam) / 2  # the step tried (clipped at 1), halved
         if dlam < min_step or not adaptive:
             why = ("fixed steps of {:.3g}".format(2 * dlam) if not adaptive
                    else "the step fell below min_step = {:.3g}".format(
