@@ -39,6 +39,7 @@ INCOMPRESSIBLE = mat.NeoHookeIsoVol.incompressible(1.0)
 
 #: label -> (thesis name of the basis, formulation token)
 METHODS = [("FE", "Q1P0"), ("VCPBG Unl", "Unl"), ("VCPBG UnlP0", "UnlP0"),
+           ("VCPPG Unl", "Unl"), ("VCPPG UnlP0", "UnlP0"),
            ("VCPBG IUnlP0", "IUnlP0"), ("VCPBG Unl+P1C", "Unl+P1C"),
            ("VCPBG U2", "U2"), ("VCPBG U2P1", "U2P1"),
            ("VCPBG U2P1C", "U2P1C")]
@@ -96,8 +97,10 @@ def one_iteration(mesh, dim, name, token, repeat):
     Kff = sp.csr_matrix(K)[free][:, free]
     t["solve"], du = best(lambda: pg.solvers.direct(Kff, -r[free]), repeat)
     t["total"] = sum(t.values())
-    return token if name == "FE" else name.split()[-1], model.N, \
-        K.nnz, t
+    label = token if name == "FE" else name.split()[-1]
+    if "PPG" in name:
+        label = "PPG " + label
+    return label, model.N, K.nnz, t
 
 
 def main(n2=40, n3=10, repeat=3):

@@ -5,8 +5,8 @@ internal force, tangent) and the linear solve.
 
 The problem is the 3-D Cook's membrane of ``demos/cook_3d.py`` (iso/vol
 neo-Hooke, lambda = 100, mu = 40, load on the far face) at ``--load`` of
-its load in ``--steps`` load steps, solved by ``skfem_pg.solvers.newton`` with one
-linear solver per method (AMG keeps its hierarchy across iterations).
+its load in ``--steps`` load steps, solved by ``skfem_pg.solvers.newton`` with
+one linear solver per method (AMG keeps its hierarchy across iterations).
 Times are per Newton iteration, failed load steps included; ratios against
 the FE method on the same nodes in the same run.
 
@@ -61,10 +61,10 @@ class Timed:
 
 
 def iterations(sc, scheme, solver, load, steps, **kw):
-    """Newton's method (``skfem_pg.solvers.newton``) on the scene at ``load`` times
-    its load in ``steps`` steps; per-iteration means of the phases (failed
-    load steps included), the Krylov iterations per solve and the basis'
-    preprocessing."""
+    """Newton's method (``skfem_pg.solvers.newton``) on the scene at
+    ``load`` times its load in ``steps`` steps; per-iteration means of the
+    phases (failed load steps included), the Krylov iterations per solve
+    and the basis' preprocessing."""
     basis, model, f, D, u_D, t_pre = sc.setup(scheme, **kw)
     material = Timed(model.material, ("stress", "tangent"))
     model.material = material
@@ -79,8 +79,8 @@ def iterations(sc, scheme, solver, load, steps, **kw):
         t_lin[0] += time.perf_counter() - t0
         return x
     t0 = time.perf_counter()
-    u, hist = pg.solvers.newton(timed, load * f, D=D, u_D=load * u_D, steps=steps,
-                        solver=solve, verbose=False)
+    u, hist = pg.solvers.newton(timed, load * f, D=D, u_D=load * u_D,
+                                steps=steps, solver=solve, verbose=False)
     wall = time.perf_counter() - t0
     n_it = sum(len(h["residuals"]) - 1 for h in hist)
     sec = timed.seconds
@@ -164,7 +164,8 @@ def write(rows, args):
          "Newton its PG / FE", "PG preprocess [s]"],
         [[r[1], r[0]] + r[2:] for r in rows])
     text = ("`python benchmarks/newton_3d.py --solver {s} --load {l} "
-            "--steps {n}`: `skfem_pg.solvers.newton` on the 3-D Cook's membrane of "
+            "--steps {n}`: `skfem_pg.solvers.newton` on the 3-D Cook's "
+            "membrane of "
             "`demos/cook_3d.py` at {l} of its load in {n} load steps; PG = "
             "VC PBG Unl on the FE mesh's nodes. Seconds per Newton "
             "iteration (failed load steps included) and the PG/FE ratios "

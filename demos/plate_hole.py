@@ -5,10 +5,10 @@ figure (Fig. 7.32); the choices here: a square plate [-L, L]² (L = 5) with
 a central hole of radius a = 1 under uniaxial tension σ∞ = 1 in x, linear
 elastic (E = 1000, ν = 0.3, plane strain: strains of 1e-3).  The quarter
 x, y ≥ 0 is modelled with symmetry conditions on both cut lines (u_x = 0 on
-x = 0, u_y = 0 on y = 0), the traction on x = L.  Structured, radially graded quadrilaterals
-(``skfem_pg.scenes.meshing.plate_with_hole``).  PPG particles collocated from the
-cells within r < 2.5 a (the high stresses around the hole), Q1 elements
-elsewhere, coupled only through the shared interface nodes.
+x = 0, u_y = 0 on y = 0), the traction on x = L.  Structured, radially graded
+quadrilaterals (``skfem_pg.scenes.meshing.plate_with_hole``).  PPG particles
+collocated from the cells within r < 2.5 a (the high stresses around the hole),
+Q1 elements elsewhere, coupled only through the shared interface nodes.
 
 Models on the same nodes: uncorrected ``PPG Unl`` and ``VCPPG V3sn Unl``
 (Table 7.1 names: bond correction and, for VC, the boundary variant sn),

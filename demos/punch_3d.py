@@ -14,10 +14,10 @@ x n/2 hexahedral node sets; PG particles at the nodes.  Reference: H1P0
 on twice the finest set's resolution (cached), the thesis' "FEM overkill".
 
 Methods: H1, H1P0, PBG Unl and, with VC, VCBCPBG V5m Unl, UnlP0,
-Unl+P1C, VCBCPPG V3m UnlP0, and for nu = 0.49999 also V5m IUnlP0 (nu = 0.5 exactly: the
-incompressible limit, as the thesis' PPG IUnlP0 picture).  The thesis'
-'VCPBG' names mean the VC boundary variant sn, which fails the patch test
-on the sliding boundaries here (``Scene`` refuses it); V5m is the
+Unl+P1C, VCBCPPG V3m UnlP0, and for nu = 0.49999 also V5m IUnlP0 (nu = 0.5
+exactly: the incompressible limit, as the thesis' PPG IUnlP0 picture).  The
+thesis' 'VCPBG' names mean the VC boundary variant sn, which fails the patch
+test on the sliding boundaries here (``Scene`` refuses it); V5m is the
 package's default.  Prints min u_z and its error against the reference,
 the collocation cells the displacement turns inside out (PG checks J > 0
 only at its integration points) and wall time (or the load factor where a

@@ -1,13 +1,15 @@
-"""The unpadded size-group layout (skfem_pg.discretization.layout) gives what the padded
-arrays give: interpolation, material evaluation, internal forces and
-tangents to round-off (≤ 1e-12 relative), on family sets of many sizes."""
+"""The unpadded size-group layout (skfem_pg.discretization.layout) gives
+what the padded arrays give: interpolation, material evaluation, internal
+forces and tangents to round-off (≤ 1e-12 relative), on family sets of
+many sizes."""
 import numpy as np
 import pytest
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.discretization.assembly import assemble
-from skfem_pg.formulations import Hyperelastic, internal_force, material_tangent
+from skfem_pg.formulations import (Hyperelastic, internal_force,
+                                   material_tangent)
 from skfem_pg.formulations.tangents import fd_tangent
 from conftest import cube, square
 
@@ -115,8 +117,8 @@ def test_fd_tangent_on_flat_and_padded_state():
 def test_unpadded_pipeline_equals_padded(boundary):
     """The default PBG pipeline (MTE1, bond, V5) runs per size group; the
     same kernels on the padded arrays give the same derivatives."""
-    from skfem_pg.discretization.corrections import (bond_correction, correction_functions,
-                                      vc_correction)
+    from skfem_pg.discretization.corrections import (
+        bond_correction, correction_functions, vc_correction)
     from skfem_pg.discretization.basis import pbg_weights
     from skfem_pg.discretization.shape import GRADIENTS
     p = pg.Particles.from_mesh(cube(3, 0.3, kind="tet"))

@@ -149,7 +149,8 @@ def test_lme_test_functions():
 @pytest.mark.parametrize("kw", [dict(test_shape="WLS1"),
                                 dict(test_shape="WTE1", shape="WTE2")])
 def test_other_test_functions_pass_the_patch_test(kw):
-    from skfem_pg.discretization.shape.least_squares import wls1_master_gradients
+    from skfem_pg.discretization.shape.least_squares import (
+        wls1_master_gradients)
     mesh = square(8, 0.3, seed=1)
     r = linear_patch_test(mesh, TOP[2], method="PPG1", **kw)
     assert r["max_error"] <= 1e-10

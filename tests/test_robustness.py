@@ -117,7 +117,8 @@ def test_too_few_nearest_neighbours_raise(k):
 
 
 def test_blown_up_corrections_raise():
-    from skfem_pg.discretization.corrections import GRADIENT_LIMIT, check_correction
+    from skfem_pg.discretization.corrections import (GRADIENT_LIMIT,
+                                                     check_correction)
     mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5),
                                     np.linspace(0, 1, 5))
     b = pg.FamilyBasis(mesh, dim=2)

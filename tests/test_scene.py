@@ -92,8 +92,10 @@ def test_prescribed_function_must_return_its_shape():
 
 def test_callables_enter_the_cache_key_by_content():
     m = unit_square(2)
-    a = Scene("k", m, mat.NeoHooke(2.0, 1.0), prescribed={"left": rotated_stretch})
-    b = Scene("k", m, mat.NeoHooke(2.0, 1.0), prescribed={"left": rotated_stretch})
+    a = Scene("k", m, mat.NeoHooke(2.0, 1.0),
+              prescribed={"left": rotated_stretch})
+    b = Scene("k", m, mat.NeoHooke(2.0, 1.0),
+              prescribed={"left": rotated_stretch})
     c = Scene("k", m, mat.NeoHooke(2.0, 1.0),
               prescribed={"left": lambda x, t: 0 * x})
     assert a.fingerprint() == b.fingerprint() != c.fingerprint()

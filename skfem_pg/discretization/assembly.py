@@ -24,9 +24,9 @@ scalars).  The local matrices
 shape ``(ne, nq, c(d+1), c(d+1))``, or as a pair ``(C, channels)`` with
 ``C`` of shape ``(ne, nq, c, nb, c, nb)`` on the ``nb`` channels listed)
 are batched matrix products, one batch per block of equal local size (for
-family bases the size groups of :mod:`skfem_pg.discretization.layout`: no padding),
-scattered into a block sparsity pattern that is computed once per basis.
-For a family basis ``k`` is a family, ``j`` a member (quadrature point)
+family bases the size groups of :mod:`skfem_pg.discretization.layout`: no
+padding), scattered into a block sparsity pattern that is computed once per
+basis. For a family basis ``k`` is a family, ``j`` a member (quadrature point)
 and ``i`` a member (basis function) with :math:`N^{kji} = \delta_{ij}`;
 for a scikit-fem cell basis ``k`` is an
 element, ``j`` a quadrature point and ``i`` a scalar shape function — the
@@ -157,7 +157,8 @@ def supports(basis):
 
 def _generic(form, *bases, **kwargs):
     """scikit-fem's own ``assemble`` of the form's scikit-fem class (also
-    for the subclasses of :mod:`skfem_pg.discretization.forms`, without recursion)."""
+    for the subclasses of :mod:`skfem_pg.discretization.forms`, without
+    recursion)."""
     for cls in (BilinearForm, LinearForm, fem.Functional):
         if isinstance(form, cls):
             return cls.assemble(form, *bases, **kwargs)
@@ -196,8 +197,8 @@ def _coefficients(values, view):
     flat ``(1, N_q)``."""
     arrs = [[np.asarray(v, dtype=float) for v in row] for row in values]
     if all(a.size == 1 for row in arrs for a in row):
-        return np.array([[float(a.ravel()[0]) for a in row] for row in arrs]), \
-            True
+        return np.array([[float(a.ravel()[0]) for a in row]
+                         for row in arrs]), True
     shape = view.coefficient_shape([a.shape for row in arrs for a in row])
     out = np.empty(shape + (len(arrs), len(arrs[0])))
     for p, row in enumerate(arrs):
@@ -367,8 +368,8 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     ``local_matrices(b, block, sl)`` returns, for the elements ``sl`` of
     block ``b`` (``block.conn``: their nodes; a :class:`FamilyBasis` has a
     block per family size, ``block.G`` its unpadded derivatives and
-    ``block.group`` its :class:`~skfem_pg.discretization.layout.Group`), an array of
-    shape ``(ne, m, m, c, c)``: entry ``[k, l, i]`` couples row node
+    ``block.group`` its :class:`~skfem_pg.discretization.layout.Group`), an
+    array of shape ``(ne, m, m, c, c)``: entry ``[k, l, i]`` couples row node
     ``l`` (test) with column node ``i`` (trial), components
     ``[c_l, c_i]``.  With ``transposed=True`` it returns the
     component-major transpose ``(ne, c, m, c, m)`` indexed

@@ -17,9 +17,10 @@ Peridynamic Bubnov–Galerkin (PBG) method:
     \delta W = \sum_k \sum_{j\in H^k} w_{kj}\, P(F^{kj}) : \delta F^{kj},
     \qquad F^{kj} = I + \sum_i u^i\otimes G^{kji}.
 
-Petrov–Galerkin (``method="PPG1"``/``"PPG2"``, :mod:`skfem_pg.discretization.petrov`): the
-same elements with weights :math:`V^k` and a separate test basis
-``basis.test`` (derivatives at the masters, VC-corrected); assemble with
+Petrov–Galerkin (``method="PPG1"``/``"PPG2"``,
+:mod:`skfem_pg.discretization.petrov`): the same elements with weights
+:math:`V^k` and a separate test basis ``basis.test`` (derivatives at the
+masters, VC-corrected); assemble with
 :func:`skfem_pg.assemble`, which picks ``basis.test`` up, or with
 scikit-fem's ``form.assemble(basis, basis.test)``.
 
@@ -85,10 +86,10 @@ class FamilyBasis(AbstractBasis):
         :class:`~skfem_pg.Particles`, or a scikit-fem mesh (its vertices
         become particles, :meth:`Particles.from_mesh`).
     families
-        :class:`~skfem_pg.discretization.families.Families`; default: mesh connectivity
-        (``families.from_mesh``) for mesh particles, otherwise a horizon of
-        1.51 h; for WTE2 a horizon of 2.51 h, small families enlarged to
-        one member more than the quadratic basis needs.
+        :class:`~skfem_pg.discretization.families.Families`; default: mesh
+        connectivity (``families.from_mesh``) for mesh particles, otherwise a
+        horizon of 1.51 h; for WTE2 a horizon of 2.51 h, small families
+        enlarged to one member more than the quadratic basis needs.
     shape
         ``"MTE1"`` (moving Taylor expansion, formulation Unl; default),
         ``"WTE1"`` (static Taylor expansion = classical correspondence,
@@ -100,14 +101,14 @@ class FamilyBasis(AbstractBasis):
         VC PPG1 without it has negative eigenvalues on the free block,
         ``tests/test_eigen.py``), off for WTE1.
     vc
-        Variationally consistent correction (:func:`~skfem_pg.discretization.corrections.
-        correction_functions`): ``"V5"`` (default with bond correction),
-        ``"V3"`` (default for MTE1 without bond correction, for WTE2 and
-        for PPG, whose test derivatives it corrects), ``"V4"`` (keeps
-        quadratic consistency), ``"V2"`` (second derivatives of WLS2
-        (5.61), keeps linear consistency; families of ``2 + q`` members
-        and more), ``"V1"`` (PPG only), ``None`` (default for
-        WTE1: the classical, uncorrected method), or
+        Variationally consistent correction
+        (:func:`~skfem_pg.discretization.corrections.correction_functions`):
+        ``"V5"`` (default with bond correction), ``"V3"`` (default for MTE1
+        without bond correction, for WTE2 and for PPG, whose test derivatives
+        it corrects), ``"V4"`` (keeps quadratic consistency), ``"V2"``
+        (second derivatives of WLS2 (5.61), keeps linear consistency;
+        families of ``2 + q`` members and more), ``"V1"`` (PPG only),
+        ``None`` (default for WTE1: the classical, uncorrected method), or
         ``"VC2"`` (second-order VC for ``shape="WTE2"``: PBG with V4
         correction functions, PPG1 (5.24) with V1 ones on its test
         derivatives; passes the quadratic patch test;
@@ -140,10 +141,10 @@ class FamilyBasis(AbstractBasis):
         quadratic patch test.  Uses the LSQR solve.
     vc_boundary
         Boundary conditions of the (singular) first-order VC system,
-        :mod:`skfem_pg.discretization.vc_boundary`: ``"min-norm"`` (default; every
-        constraint with FE-consistent :math:`A^i`), or the thesis' ``"p"``,
-        ``"s"``, ``"sn"``.  With ``"s"``/``"sn"`` the surface particles'
-        discrete area vectors (4.35) differ from FE's by
+        :mod:`skfem_pg.discretization.vc_boundary`: ``"min-norm"`` (default;
+        every constraint with FE-consistent :math:`A^i`), or the thesis'
+        ``"p"``, ``"s"``, ``"sn"``.  With ``"s"``/``"sn"`` the surface
+        particles' discrete area vectors (4.35) differ from FE's by
         ``basis.area_correction``, which the loads of
         :mod:`skfem_pg.discretization.loads` include.
 
@@ -151,10 +152,11 @@ class FamilyBasis(AbstractBasis):
         Largest accepted constraint residual after the VC correction,
         relative to :math:`h^{d-1}` (default 1e-8: the patch test holds
         to about 1e-10).  Above it, and for non-finite or blown-up
-        derivatives (:data:`~skfem_pg.discretization.corrections.GRADIENT_LIMIT`), the
-        basis raises :class:`~skfem_pg.errors.CorrectionError` naming the
-        worst particles.  ``None`` keeps an inexact correction with a
-        warning (studies of the incompatible V2/V4/VC2 systems).
+        derivatives
+        (:data:`~skfem_pg.discretization.corrections.GRADIENT_LIMIT`), the
+        basis raises :class:`~skfem_pg.errors.CorrectionError` naming the worst
+        particles.  ``None`` keeps an inexact correction with a warning
+        (studies of the incompatible V2/V4/VC2 systems).
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
         basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
@@ -162,8 +164,8 @@ class FamilyBasis(AbstractBasis):
         (linear least squares with a constant term), ``"WLS2"`` (its
         quadratic version), ``"MLS1"`` (moving least squares: weights and
         moment matrix differentiated too) or ``"LME"`` (local
-        maximum entropy, :mod:`skfem_pg.discretization.shape.lme`, locality ``lme_mu``;
-        surface masters, where LME degenerates, keep ``"master"``).
+        maximum entropy, :mod:`skfem_pg.discretization.shape.lme`, locality
+        ``lme_mu``; surface masters, where LME degenerates, keep ``"master"``).
 
     Attributes
     ----------
@@ -173,10 +175,12 @@ class FamilyBasis(AbstractBasis):
         ``(nf, m)`` weights :math:`w_{kj}` (PPG: :math:`V^j`).
     test
         PPG only: the test basis (same families, dofs and weights, test
-        derivatives of :func:`skfem_pg.discretization.petrov.element_test_gradients`); ``None``
-        for PBG.
+        derivatives of
+        :func:`skfem_pg.discretization.petrov.element_test_gradients`);
+        ``None`` for PBG.
     vc_report
-        :class:`~skfem_pg.discretization.corrections.VCReport` (``None`` without VC).
+        :class:`~skfem_pg.discretization.corrections.VCReport` (``None``
+        without VC).
     area_correction
         ``(dim, np)`` discrete minus FE-consistent surface area vectors
         (``vc_boundary`` ``"s"``/``"sn"``), else ``None``.
@@ -436,10 +440,10 @@ class FamilyBasis(AbstractBasis):
 
     def _unpadded_pipeline(self, vc_solver, area_vectors, vc_tolerance):
         """PBG with MTE1/WTE1 derivatives, bond and V3/V5 correction, one
-        size group at a time (:mod:`skfem_pg.discretization.layout`): work and storage
-        :math:`\\propto \\sum_k m_k^2` instead of :math:`n_f m_{max}^2`;
-        the kernels are the padded ones, run on each group's own
-        families."""
+        size group at a time (:mod:`skfem_pg.discretization.layout`): work
+        and storage :math:`\\propto \\sum_k m_k^2` instead of
+        :math:`n_f m_{max}^2`; the kernels are the padded ones, run on each
+        group's own families."""
         p, fam = self.particles, self.families
         x, V, n = p.x, p.volumes, self.weight_exponent
         L = fam.groups()
@@ -540,8 +544,8 @@ class FamilyBasis(AbstractBasis):
 
     @property
     def layout(self):
-        """:class:`~skfem_pg.discretization.layout.SizeGroups` of the families: the
-        unpadded layout of the hot paths."""
+        """:class:`~skfem_pg.discretization.layout.SizeGroups` of the
+        families: the unpadded layout of the hot paths."""
         return self.families.groups()
 
     @property

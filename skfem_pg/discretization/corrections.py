@@ -1,7 +1,8 @@
 r"""Bond correction and first-order variationally consistent (VC) correction.
 
 Bond correction (BC), thesis (5.53)–(5.55), linear bases only
-    For a neighbour ``j`` of master ``k``, :math:`e = \Delta X^{kj}/|\Delta X^{kj}|`,
+    For a neighbour ``j`` of master ``k``,
+    :math:`e = \Delta X^{kj}/|\Delta X^{kj}|`,
     :math:`Q^{kj} = I - e\otimes e` and
 
     .. math:: \tilde G^{kji} = Q^{kj}\hat G^{kji}
@@ -12,8 +13,9 @@ Bond correction (BC), thesis (5.53)–(5.55), linear bases only
     linear consistency is kept.  :math:`Q^{kk} = I`.
 
 VC correction (5.56)–(5.68)
-    Ansatz :math:`G \leftarrow G + C`, :math:`C^{kji} = Q^{kj}\alpha^k\varphi^{ki}`,
-    one unknown :math:`\alpha^k\in R^d` per family, with correction function
+    Ansatz :math:`G \leftarrow G + C`,
+    :math:`C^{kji} = Q^{kj}\alpha^k\varphi^{ki}`, one unknown
+    :math:`\alpha^k\in R^d` per family, with correction function
     :math:`\varphi^{ki} = N^{kki}_{MLS1} - \delta_{ki}` (V3 (5.62): no Q;
     V5 (5.64): with the bond projector Q, which keeps the bond mapping).
     The unknowns make the PBG integration constraint (5.18) hold,
@@ -355,10 +357,11 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     G
         ``(nf, m, m, d)`` derivatives (bond corrected for V5).  Unpadded:
         ``G``, ``dx``, ``fam`` and ``phi`` may instead be lists with one
-        entry per size group (:mod:`skfem_pg.discretization.layout`; ``fam`` the groups'
-        :meth:`~skfem_pg.discretization.layout.SizeGroups.subset` families) and ``index``
-        the groups' family indices; the corrected ``G`` is then a list
-        too.
+        entry per size group (:mod:`skfem_pg.discretization.layout`; ``fam``
+        the groups'
+        :meth:`~skfem_pg.discretization.layout.SizeGroups.subset` families) and
+        ``index`` the groups' family indices; the corrected ``G`` is then a
+        list too.
     dx
         ``(nf, m)`` PBG weights :math:`w_{kj}`.
     x, volumes
@@ -379,10 +382,10 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         ``"direct"`` (one scalar sparse LU of the pinned system; the
         default, ``"auto"``), ``"amg"`` (the same pinned system by
         AMG-GMRES, linear in the particle count; ``"auto"`` in 3-D above
-        :data:`AMG_VC_LIMIT_3D` particles) or ``"lsqr"`` (scipy LSQR; a reference, its
-        iteration count grows with the node count).  V1, V2 and V4, and any
-        ``exclude``, take LSQR: their systems lack the structure the
-        direct solve relies on (V4's left null space holds the quadratic
+        :data:`AMG_VC_LIMIT_3D` particles) or ``"lsqr"`` (scipy LSQR; a
+        reference, its iteration count grows with the node count).  V1, V2 and
+        V4, and any ``exclude``, take LSQR: their systems lack the structure
+        the direct solve relies on (V4's left null space holds the quadratic
         fields and is incompatible with the surface terms, V1 does not
         keep the linear fields in it).
     exclude
@@ -390,8 +393,9 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         whose equations are eliminated); needed by V4 for round-off
         patch tests.
     boundary
-        How the singular system is made regular (:mod:`skfem_pg.discretization.vc_boundary`):
-        ``"min-norm"`` (default: all constraints with FE-consistent
+        How the singular system is made regular
+        (:mod:`skfem_pg.discretization.vc_boundary`): ``"min-norm"`` (default:
+        all constraints with FE-consistent
         :math:`A^i`, minimum-norm solution), or the thesis' variants
         ``"p"`` (V3/V5: correction fixed at ``d + 1`` anchor particles),
         ``"s"`` (fixed at all surface particles, their constraints
@@ -408,7 +412,8 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         ``area`` but keep their constraints
         (:meth:`~skfem_pg.Particles.surface_area_vectors`); under ``sn``
         the surface particles on the interface's edge are fixed fully, as
-        under ``s`` (:func:`~skfem_pg.discretization.vc_boundary.interface_edge`).
+        under ``s``
+        (:func:`~skfem_pg.discretization.vc_boundary.interface_edge`).
 
     index
         With list arguments: per group its family indices.

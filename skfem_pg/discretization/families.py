@@ -89,8 +89,9 @@ class Families:
         return self._padded
 
     def groups(self):
-        """The unpadded layout: :class:`~skfem_pg.discretization.layout.SizeGroups` of
-        the families (cached)."""
+        """The unpadded layout:
+        :class:`~skfem_pg.discretization.layout.SizeGroups` of the families
+        (cached)."""
         if self._groups is None:
             from .layout import SizeGroups
             self._groups = SizeGroups(self)

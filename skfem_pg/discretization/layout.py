@@ -80,7 +80,8 @@ class SizeGroups:
 
     def subset(self, group):
         """The families of ``group`` as a
-        :class:`~skfem_pg.discretization.families.Families` of their own (no padding: the
+        :class:`~skfem_pg.discretization.families.Families` of their own (no
+        padding: the
         batched kernels run on it unchanged)."""
         from .families import Families
         nf, m = group.members.shape
@@ -131,6 +132,7 @@ class SizeGroups:
         return out
 
     def __repr__(self):
-        return "<SizeGroups: {} families in {} sizes {}..{}, {} points>".format(
+        return ("<SizeGroups: {} families in {} sizes {}..{}, {} points>"
+                ).format(
             self.n_families, len(self), self.groups[0].m, self.m_max,
             self.n_points)

@@ -262,7 +262,8 @@ class Particles:
         return float(np.mean(self.volumes[self.active]) ** (1.0 / self.dim))
 
     def __repr__(self):
-        return "<skfem_pg Particles: {} {} in {}-D, {} active, h={:.4g}>".format(
+        return ("<skfem_pg Particles: {} {} in {}-D, {} active, h={:.4g}>"
+                ).format(
             self.n, self.kind, self.dim, int(self.active.sum()), self.spacing)
 
     # -- validation --------------------------------------------------------

@@ -81,7 +81,8 @@ def reverse_slots(fam):
         raise ValueError(
             "families are not pairwise: particle {} is in the family of "
             "particle {} but not the other way round; complete them with "
-            "skfem_pg.discretization.petrov.pairwise".format(mem[f, q], fam.masters[f]))
+            "skfem_pg.discretization.petrov.pairwise".format(
+                mem[f, q], fam.masters[f]))
     return rev
 
 

@@ -36,9 +36,9 @@ unknowns with blocks :math:`\varphi^{ki} M^{ki}`,
 
 solved for its minimum-norm least-squares solution (LSQR; lengths scaled
 by the mean spacing), or, with the thesis' boundary variant ``s``
-(:mod:`skfem_pg.discretization.vc_boundary`), with all correction factors of surface
-particles fixed to zero and their constraints released: a square system,
-one sparse LU.  The surface particles' discrete :math:`A^i` and
+(:mod:`skfem_pg.discretization.vc_boundary`), with all correction factors of
+surface particles fixed to zero and their constraints released: a square
+system, one sparse LU.  The surface particles' discrete :math:`A^i` and
 :math:`A_2^i` then differ from FE's (``VCReport.area_correction``,
 ``area2_correction``).  Vertex particles of a mesh only (FE-consistent
 :math:`A^i`, :math:`A_2^i`).
@@ -108,7 +108,8 @@ def ppg1_second_order_functions(phi, fam, X, h):
     by ``h``) that carry the second-order unknowns of PPG1: they sum to
     zero over ``i``, so the corrected test derivatives keep
     :math:`\sum_i G_t^{ki} = 0`, without which the element view of PPG1
-    (bond pairs, :func:`skfem_pg.discretization.petrov.element_test_gradients`) would not
+    (bond pairs, :func:`skfem_pg.discretization.petrov.element_test_gradients`)
+    would not
     have the constraints (5.16), (5.24) of the master view."""
     mem, mask = fam.padded()
     P = (X / h).T[mem]

@@ -2,10 +2,10 @@ r"""Boundary conditions of the VC correction system, thesis section 5.3
 (Table 7.1: ``p``, ``s``, ``sn``).
 
 The constraint system ``A α = b`` of a first-order VC correction
-(:func:`~skfem_pg.discretization.corrections.vc_correction`: rows = the integration
-constraints (5.18) of the particles, ``d`` each; columns = the correction
-factors :math:`\alpha^k` of the families, ``d`` each) is singular: the
-consistency modes it preserves are zero eigenvalues (``d + d²`` for V3/V5).
+(:func:`~skfem_pg.discretization.corrections.vc_correction`: rows = the
+integration constraints (5.18) of the particles, ``d`` each; columns = the
+correction factors :math:`\alpha^k` of the families, ``d`` each) is singular:
+the consistency modes it preserves are zero eigenvalues (``d + d²`` for V3/V5).
 The thesis removes them with boundary conditions on the correction factors:
 
 ``p``
@@ -27,9 +27,10 @@ With ``s`` and ``sn`` the system is square, ``d·n_int + (d−1)·n_surf``
 (``sn``) or ``d·n_int`` (``s``) equations in as many unknowns, and solved by
 one sparse LU.  Neumann loads must then use the discrete surface vectors
 (thesis (4.32)–(4.35)); :func:`skfem_pg.discretization.loads.stress_load` and
-:func:`~skfem_pg.discretization.loads.traction` do so through ``basis.area_correction``.
-The package's default (``"min-norm"``) imposes every constraint with the
-FE-consistent :math:`A^i` and takes the minimum-norm solution instead.
+:func:`~skfem_pg.discretization.loads.traction` do so through
+``basis.area_correction``. The package's default (``"min-norm"``) imposes every
+constraint with the FE-consistent :math:`A^i` and takes the minimum-norm
+solution instead.
 
 Measured (README): all variants pass the linear patch test, none is more
 accurate than min-norm on the 2-D manufactured problem (L2 / Q1: 2.46

@@ -117,7 +117,8 @@ class Hyperelastic:
     @kernel
     def state(self, u):
         """``{"F": ...}`` at the quadrature points: for a family basis in
-        the unpadded flat layout ``(d, d, 1, N_q)`` (:mod:`skfem_pg.discretization.layout`),
+        the unpadded flat layout ``(d, d, 1, N_q)``
+        (:mod:`skfem_pg.discretization.layout`),
         so the material is evaluated only at real members."""
         if hasattr(self.basis, "layout"):
             return {"F": self.basis.interpolate(u, flat=True).grad

@@ -55,7 +55,8 @@ def distort(mesh, amount=0.3, seed=0):
 
 def _bilinear_map(xi, eta, corners):
     c = corners
-    return ((1 - xi) * (1 - eta) * c[0][:, None] + xi * (1 - eta) * c[1][:, None]
+    return ((1 - xi) * (1 - eta) * c[0][:, None]
+            + xi * (1 - eta) * c[1][:, None]
             + xi * eta * c[2][:, None] + (1 - xi) * eta * c[3][:, None])
 
 
@@ -219,7 +220,8 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
 
 def geo_path(name):
     """Path of a ``.geo`` file shipped with the package
-    (``skfem_pg/scenes/meshes/``: cook.geo, cook3d.geo, cube.geo, square.geo)."""
+    (``skfem_pg/scenes/meshes/``: cook.geo, cook3d.geo, cube.geo,
+    square.geo)."""
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "meshes")
     fn = os.path.join(here, name)
     if not os.path.isfile(fn):
