@@ -177,9 +177,10 @@ def test_nearly_incompressible_small_load_converges_at_the_round_off_floor():
 @pytest.mark.parametrize("kind", ["symmetric", "saddle", "needs pivoting",
                                   "nonsymmetric"])
 def test_direct_solver_paths(kind):
-    """pg.solvers.direct: diagonal pivots for symmetric matrices (checked
-    by the residual, refactorized with partial pivoting when they fail),
-    COLAMD for saddle points, partial pivoting otherwise: all exact."""
+    """pg.solvers.direct: diagonal pivots for symmetric matrices, threshold
+    pivoting keeping the diagonal for the others (both checked by the
+    residual, refactorized with partial pivoting when they fail), COLAMD
+    for saddle points: all exact."""
     import scipy.sparse as sp
     rng = np.random.default_rng(3)
     n = 60
@@ -200,8 +201,9 @@ def test_direct_solver_paths(kind):
                            side_effect=spsolve) as partial:
         x = pg.solvers.direct(A, b)
     assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
-    # partial pivoting (spsolve) only where diagonal pivots cannot do
-    assert partial.called == (kind != "symmetric")
+    # spsolve (partial pivoting) only for saddle points and where diagonal
+    # pivots fail
+    assert partial.called == (kind in ("saddle", "needs pivoting"))
 
 
 def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):

@@ -53,10 +53,12 @@ def direct(A, b, ordering="auto", **kwargs):
     grids; T1/Q1 and PG) the fastest of scipy's options or within 1.3x of
     it, while each SuperLU ordering alone is up to 27x slower on one of
     them.  A symmetric matrix is factorized with diagonal pivots
-    (SuperLU's ``SymmetricMode``), checked by its residual and refactorized
-    with partial pivoting if that is above :data:`PIVOT_CHECK` (condensed
-    mixed tangents, 3.4k unknowns: UnlP0 0.08 s against 0.9 s, Unl+P1C
-    0.5 s against 3.3 s; benchmarks/mixed_newton.py).  A saddle point
+    (SuperLU's ``SymmetricMode``), a non-symmetric one with threshold
+    pivoting that keeps the diagonal (:data:`DIAG_PIVOT`); either is
+    checked by its residual and refactorized with partial pivoting if that
+    is above :data:`PIVOT_CHECK` (condensed mixed tangents, 3.4k unknowns:
+    UnlP0 0.08 s against 0.9 s, Unl+P1C 0.5 s against 3.3 s, PPG UnlP0
+    0.1 s against 0.95 s; benchmarks/mixed_newton.py).  A saddle point
     (zero diagonal entries: the pressure rows of IUnlP0, U2P1C) goes to
     ``COLAMD`` instead (IUnlP0, 5k unknowns: 0.25 s against 9.6 s).
     ``ordering="colamd"``: SuperLU's ``COLAMD``; on 3-D Cook
@@ -84,18 +86,19 @@ def direct(A, b, ordering="auto", **kwargs):
     p = reverse_cuthill_mckee(A, symmetric_mode=True)
     Ap, bp = A[p][:, p].tocsc(), b[p]
     x = np.empty_like(b)
-    if _symmetric(A):
-        try:
-            xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A",
-                          diag_pivot_thresh=0.0,
-                          options={"SymmetricMode": True}).solve(bp)
-        except RuntimeError:  # a zero diagonal pivot: pivot partially
-            xp = np.full_like(bp, np.nan)
-        scale = np.abs(Ap).max() * max(np.abs(xp).max(), 1e-300)
-        if np.all(np.isfinite(xp)) and np.abs(Ap @ xp - bp).max() \
-                <= PIVOT_CHECK * max(scale, np.abs(bp).max()):
-            x[p] = xp
-            return x
+    # diagonal pivots first (symmetric: SuperLU's SymmetricMode; otherwise
+    # threshold pivoting that prefers the diagonal), checked by the residual
+    opts = (dict(diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+            if _symmetric(A) else dict(diag_pivot_thresh=DIAG_PIVOT))
+    try:
+        xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A", **opts).solve(bp)
+    except RuntimeError:  # a zero pivot: pivot partially
+        xp = np.full_like(bp, np.nan)
+    scale = np.abs(Ap).max() * max(np.abs(xp).max(), 1e-300)
+    if np.all(np.isfinite(xp)) and np.abs(Ap @ xp - bp).max() \
+            <= PIVOT_CHECK * max(scale, np.abs(bp).max()):
+        x[p] = xp
+        return x
     x[p] = spl.spsolve(Ap, bp, permc_spec="MMD_AT_PLUS_A")
     return x
 
@@ -103,6 +106,10 @@ def direct(A, b, ordering="auto", **kwargs):
 #: largest relative residual ``|A x - b| / (|A| |x|)`` accepted from a
 #: factorization with diagonal pivots before partial pivoting is tried
 PIVOT_CHECK = 1e-11
+#: SuperLU's ``diag_pivot_thresh`` for non-symmetric matrices: the diagonal
+#: is kept while it is at least this fraction of the column's largest entry
+#: (PPG UnlP0, 3.4k unknowns: 0.1 s against 0.95 s with partial pivoting)
+DIAG_PIVOT = 0.01
 
 
 def _symmetric(A, tol=1e-12):
