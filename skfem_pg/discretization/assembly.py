@@ -311,7 +311,7 @@ def _scatter_index(u, inv, m, nc, transposed):
     return idx.ravel(), full
 
 
-def _assemble_bilinear(form, basis, view, vview, kwargs):
+def _assemble_bilinear(form, basis, view, vview, kwargs, local_extra=None):
     w, probes = _setup(form, basis, view, kwargs)
     nc = view.nc
     nch = view.dim + 1
@@ -356,7 +356,10 @@ def _assemble_bilinear(form, basis, view, vview, kwargs):
         Y = Y.reshape(nfc, nc, nq * nb, nc * m)
         # K[k, a, i, c, l]
         #     = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
-        return np.matmul(GT, Y).reshape(nfc, nc, m, nc, m)
+        K = np.matmul(GT, Y).reshape(nfc, nc, m, nc, m)
+        if local_extra is not None:
+            K += local_extra(bi, blk, sl)
+        return K
 
     return assemble_local(basis, local_matrices, view, transposed=True)
 
@@ -436,7 +439,14 @@ def assemble(form, basis, vbasis=None, **kwargs):
     ``basis`` itself or, for a Petrov–Galerkin family basis, ``basis.test``
     (also for linear forms: PPG internal forces).  Other combinations are
     passed on to ``form.assemble``.
+
+    ``local_extra(b, block, sl)`` (bilinear forms on the batched path):
+    local matrices in :func:`assemble_local`'s transposed layout ``(ne, c,
+    m, c, m)`` added to the form's before the one scatter — a term that is
+    not a pointwise form, e.g. the condensed volumetric stiffness of a
+    mixed formulation (:meth:`~.elementwise.Elements.quadratic_local`).
     """
+    local_extra = kwargs.pop("local_extra", None)
     if vbasis is None:
         test = getattr(basis, "test", None)
         vbasis = basis if test is None else test
@@ -450,9 +460,14 @@ def assemble(form, basis, vbasis=None, **kwargs):
         vview = None
     if view is not None and vview is not None:
         if isinstance(form, BilinearForm):
-            return _assemble_bilinear(form, basis, view, vview, kwargs)
+            return _assemble_bilinear(form, basis, view, vview, kwargs,
+                                      local_extra)
         if isinstance(form, LinearForm):
             return _assemble_linear(form, basis, vview, kwargs)
+    if local_extra is not None:
+        raise ValueError("local_extra needs a bilinear form on the batched "
+                         "path (a FamilyBasis or a scikit-fem cell basis "
+                         "tested with itself)")
     if isinstance(form, LinearForm):
         return _generic(form, vbasis, **kwargs)
     if vbasis is basis:

@@ -121,23 +121,39 @@ class Elements:
         out = []
         for blk in self.view.blocks:
             Gh = blk.ext_grad(slice(None), range(1, d + 1))  # (k, j, i, b)
+            ne, nq, nloc = Gh.shape[:3]
             Qw = self._take(Q, blk) * blk.dx  # (c, b, k, j)
             Pb = self._take(Phi, blk)  # (a, k, j)
-            QP = np.einsum("cbkj,akj->kjcba", Qw, Pb)
-            out.append(np.einsum("kjcba,kjib->kica", QP, Gh))
+            # batched matrix products over (j, b): (k, i, jb) @ (k, jb, c)
+            Gt = np.ascontiguousarray(np.swapaxes(Gh, 1, 2)).reshape(
+                ne, nloc, nq * d)
+            QP = np.einsum("cbkj,akj->akjbc", Qw, Pb).reshape(
+                len(Pb), ne, nq * d, -1)
+            out.append(np.stack([Gt @ QPa for QPa in QP], axis=-1))
         return out
 
     def quadratic(self, C, S):
         r"""Sparse :math:`\sum_e C_e^T S_e C_e` (``N × N``) for the local
         moments ``C`` of :meth:`moments` and per-element symmetric ``S``
         ``(n, q, q)``."""
+        return assemble_local(self.basis, self.quadratic_local(C, S),
+                              self.view, transposed=True)
+
+    def quadratic_local(self, C, S):
+        """The local matrices of :meth:`quadratic` as a function for
+        :func:`~.assembly.assemble_local` with ``transposed=True`` (or for
+        ``assemble(..., local_extra=)``, which adds them to a form's in
+        one scatter): ``[k, c_i, i, c_l, l]``."""
         Sb = [np.asarray(S)[blk.index] for blk in self.view.blocks]
 
         def local_matrices(bi, blk, sl):
             Cb = C[bi][sl]  # (k, l, c, a)
-            SC = np.einsum("kab,kicb->kica", Sb[bi][sl], Cb)
-            return np.einsum("klca,kida->klicd", Cb, SC)
-        return assemble_local(self.basis, local_matrices, self.view)
+            k, m, nc, q = Cb.shape
+            Ct = np.ascontiguousarray(Cb.transpose(0, 2, 1, 3)).reshape(
+                k, nc * m, q)  # [k, (c, l), a]
+            SC = Ct @ Sb[bi][sl]  # S symmetric: [k, (d, i), a]
+            return (SC @ np.swapaxes(Ct, 1, 2)).reshape(k, nc, m, nc, m)
+        return local_matrices
 
     def _take(self, a, blk):
         """Point data ``(..., *point_shape)`` of the block's elements,

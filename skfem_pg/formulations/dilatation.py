@@ -142,18 +142,20 @@ class MeanDilatation(Hyperelastic):
                 + state["p"] * state["J"] * FinvT)
 
     def _volumetric_tangent(self, state):
-        """:math:`\\sum_e C_e^T M^{-1}(\\Phi^T W U''\\Phi) M^{-1} C_e`."""
+        """The local matrices of :math:`\\sum_e C_e^T M^{-1}(\\Phi^T W
+        U''\\Phi) M^{-1} C_e`."""
         E = self.elements
         Th = state["Theta"]
         Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
         S = self._Minv @ E.gram(self.Phi, Upp) @ self._Minv
         C = E.moments(state["J"] * np.swapaxes(state["Finv"], 0, 1),
                       self.Phi)
-        return E.quadratic(C, S)
+        return E.quadratic_local(C, S)
 
     @kernel
     def tangent(self, state):
         A = self.material.tangent(state["F"]) + state["p"] * _d_JFinvT(
             state["J"], state["Finv"])
-        return (assemble(material_tangent, self.basis, A=A)
-                + self._volumetric_tangent(state))
+        # one scatter for the pointwise and the condensed volumetric part
+        return assemble(material_tangent, self.basis, A=A,
+                        local_extra=self._volumetric_tangent(state))
