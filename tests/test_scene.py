@@ -127,3 +127,19 @@ def test_sliding_boundaries_pass_the_patch_test_or_are_refused(dim):
             assert ratio.max() - ratio.min() <= 1e-10 * abs(ratio).max()
     with pytest.raises(ValueError, match="sliding"):
         scene.solve("VCPBG Unl")
+
+
+def test_check_sliding_names_the_particle():
+    """The guard for linear solves of one's own: s / sn with a particle
+    that has only some components prescribed raises, naming it; all
+    components, or the min-norm variant, pass."""
+    from skfem_pg.dofs import check_sliding
+    import skfem_pg as pg
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 1, 4),
+                                    np.linspace(0, 1, 4))
+    sn = pg.FamilyBasis(mesh, dim=2, vc_boundary="sn")
+    bottom = np.flatnonzero(np.isclose(mesh.p[1], 0.0))
+    with pytest.raises(ValueError, match=r"particle \d+ at .* 1 of its 2"):
+        check_sliding(sn, 2 * bottom + 1)
+    check_sliding(sn, np.concatenate([2 * bottom, 2 * bottom + 1]))
+    check_sliding(pg.FamilyBasis(mesh, dim=2), 2 * bottom + 1)

@@ -221,31 +221,6 @@ class Scene:
         raise ValueError("{} needs a {} node set, the scene has a {}".format(
             method, need.__name__, type(mesh).__name__))
 
-    def _check_sliding(self, basis):
-        """The surface variants ``s`` / ``sn`` of the VC system (thesis
-        5.3) fix the corrections' boundary terms at the surface particles
-        for all / the normal components: on a sliding boundary (some
-        components prescribed, the others free) the free components carry
-        a spurious force and the linear patch test fails (a uniaxially
-        compressed block on a roller bottom: u_z off by 25 % in 3-D, the
-        strain spread 2.4 % in 2-D with ``sn``; ``min-norm`` and ``p``:
-        1e-14).  Refused rather than answered wrongly."""
-        if getattr(basis, "vc", None) is None or \
-                getattr(basis, "vc_boundary", None) not in ("s", "sn"):
-            return
-        partial = {name: sorted(how) for name, how in self.prescribed.items()
-                   if not callable(how) and len(how) < self.dim}
-        if partial:
-            raise ValueError(
-                "the VC boundary variant {!r} (the thesis' default for "
-                "'VCPBG ...' names) fails the patch test on sliding "
-                "boundaries, and {} prescribe(s) only some components "
-                "({}); use 'VCBCPBG V5m ...' (vc_boundary='min-norm', the "
-                "keyword default) or 'p'".format(
-                    basis.vc_boundary, ", ".join(map(repr, partial)),
-                    "; ".join("{}: {}".format(k, v)
-                              for k, v in partial.items())))
-
     def _dirichlet(self, basis):
         """Prescribed dofs ``D`` and their values as a function of the
         load factor, ``u_D(t)`` (a full-length vector)."""
@@ -342,7 +317,6 @@ class Scene:
             mesh = self.mesh if mesh is None else mesh
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
                                 **basis_kwargs)
-            self._check_sliding(basis)
             model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from ..dofs import as_dofs
+from ..dofs import as_dofs, check_sliding
 from .linear import linear_solver
 
 
@@ -123,6 +123,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
+    check_sliding(basis, Dd)
     I = np.setdiff1d(np.arange(N), Dd)
     f_ext = _padded(f_ext, n_u, N, "f_ext")
     if callable(u_D):
