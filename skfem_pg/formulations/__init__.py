@@ -11,7 +11,8 @@ The model interface (fields, residual, tangent) is described in
                        pressure and dilatation per element — FE
                        Q1P0/H1P0, PBG UnlP0, U2P1
 ``master_dilatation``  :class:`MasterDilatation`: PPG UnlP0, the
-                       volumetric part once per particle, at the master
+                       volumetric part once per particle, at the master;
+                       :class:`MasterIncompressible`: PPG IUnlP0
 ``incompressible``     :class:`IncompressibleP0`: nu = 0.5, one pressure
                        per element as a global unknown — PBG IUnlP0, FE
                        Q1P0/H1P0
@@ -25,12 +26,13 @@ from .linear import linear_elasticity
 from .displacement import Hyperelastic, internal_force, material_tangent
 from .dilatation import MeanDilatation
 from .incompressible import IncompressibleP0
-from .master_dilatation import MasterDilatation
+from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 from .by_name import model_for
 from .tangents import fd_tangent
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
+           "MasterIncompressible",
            "IncompressibleP0",
            "NodalPressure", "model_for", "fd_tangent"]

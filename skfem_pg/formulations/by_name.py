@@ -13,7 +13,9 @@ token                   model
 ``Q1P0``, ``H1P0``      :class:`~.dilatation.MeanDilatation`, or with an
                         incompressible material
                         :class:`~.incompressible.IncompressibleP0`
-``IUnlP0``              :class:`~.incompressible.IncompressibleP0` (PBG)
+``IUnlP0``              :class:`~.incompressible.IncompressibleP0` (PBG),
+                        :class:`~.master_dilatation.MasterIncompressible`
+                        (PPG)
 ``U2P1C``               :class:`~.nodal.NodalPressure` (PBG, WTE2 basis)
 ``Unl+P1C``             :class:`~.nodal.NodalPressure` with the bubble
                         (PBG, MTE1 basis)
@@ -27,7 +29,7 @@ import numpy as np
 from .dilatation import MeanDilatation
 from .displacement import Hyperelastic
 from .incompressible import IncompressibleP0
-from .master_dilatation import MasterDilatation
+from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 
 #: built formulation tokens beyond the displacement ones
@@ -64,7 +66,8 @@ def model_for(formulation, basis, material, tangent="consistent"):
         if formulation == "UnlP0" and _incompressible(material):
             raise ValueError("UnlP0 condenses the pressure with a finite "
                              "bulk modulus; for nu = 0.5 use IUnlP0")
-        if formulation == "UnlP0" and getattr(basis, "is_petrov", False):
-            return MasterDilatation.of(basis, material)
+        if getattr(basis, "is_petrov", False):  # PPG: at the master
+            return (MasterDilatation if formulation == "UnlP0"
+                    else MasterIncompressible).of(basis, material)
         return MIXED[formulation].of(basis, material)
     return Hyperelastic(basis, material, tangent=tangent)

@@ -57,8 +57,9 @@ class IncompressibleP0(Hyperelastic):
     def __init__(self, basis, mu):
         if getattr(basis, "is_petrov", False):
             raise NotImplementedError(
-                "IUnlP0 on a Petrov–Galerkin basis (PPG IUnlP0) is not "
-                "built; use a PBG basis")
+                "IncompressibleP0 integrates over the family (PBG); PPG "
+                "IUnlP0 (the constraint at the master) is "
+                "MasterIncompressible")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.elements = Elements(basis)
         self._Phi = self.elements.polynomials(0)

@@ -160,3 +160,106 @@ class MasterDilatation(Hyperelastic):
             self._pattern = FixedPattern(rows.ravel(), cols.ravel(),
                                          self.n_u)
         return K + self._pattern.matrix(loc.ravel())
+
+
+class MasterIncompressible(MasterDilatation):
+    r"""PPG IUnlP0: ν = 0.5 exactly, the constraint :math:`J^{kk} = 1`
+    once per particle with its pressure :math:`p^k` as a global unknown
+    (thesis 6.2, IUnlP0; used as PPG IUnlP0 in 7.3.3):
+
+    .. math::
+
+        \delta W = \sum_k V^k \sum_{j\in H^k} \big[P_{iso}(F^{jk})
+            + p^k J^{kk} F^{kk,-T}\big] : \big((\delta u^j - \delta u^k)
+            \otimes G_t^{kkj}\big) + \sum_k V^k\,\delta p^k (J^{kk} - 1).
+
+    Unknowns ``[u, p]``, one p per particle (family); the tangent is a
+    non-symmetric saddle point (zero p-p block: the direct solver's
+    COLAMD path).  Isochoric neo-Hooke with shear modulus ``mu``."""
+
+    def __init__(self, basis, mu):
+        super().__init__(basis, mu, 1.0)  # K unused: no volumetric energy
+        self.K = np.inf
+
+    @classmethod
+    def of(cls, basis, material):
+        """From :meth:`NeoHookeIsoVol.incompressible(mu)
+        <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
+        if not isinstance(material, NeoHookeIsoVol) \
+                or np.isfinite(material.K):
+            raise ValueError(
+                "PPG IUnlP0 is the incompressible limit (nu = 0.5): use "
+                "NeoHookeIsoVol.incompressible(mu), got {!r}".format(
+                    material))
+        return cls(basis, material.mu)
+
+    @property
+    def N(self):
+        return self.n_u + len(self.V)
+
+    @property
+    def blocks(self):
+        return [("u", slice(0, self.n_u)), ("p", slice(self.n_u, self.N))]
+
+    def _split(self, x):
+        x = np.asarray(x, dtype=float)
+        if x.shape != (self.N,):
+            raise ValueError("PPG IUnlP0 unknowns: {} displacements and {} "
+                             "pressures ({} in all), got shape {}".format(
+                                 self.n_u, len(self.V), self.N, x.shape))
+        return x[:self.n_u], x[self.n_u:]
+
+    @kernel
+    def state(self, x):
+        u, p = self._split(x)
+        s = Hyperelastic.state(self, u)
+        Fm = self._master(u)
+        Finv, J = inverse_and_det(Fm)
+        s.update(Fm=Fm, Finv_m=Finv, J_m=J, p=p,
+                 P_vol=p * J * np.swapaxes(Finv, 0, 1))
+        return s
+
+    def energy(self, state):
+        return Hyperelastic.energy(self, state) + float(np.sum(
+            self.V * state["p"] * (state["J_m"] - 1.0)))
+
+    def fields(self, x):
+        _, p = self._split(x)
+        s = self.state(x)
+        n = self.basis.particles.n
+        out = {"p": np.empty(n), "Theta": np.empty(n)}
+        masters = self.basis.families.masters
+        out["p"][masters], out["Theta"][masters] = p, s["J_m"]
+        return out
+
+    @kernel
+    def internal_force(self, state):
+        r_u = MasterDilatation.internal_force(self, state)
+        return np.concatenate([r_u, self.V * (state["J_m"] - 1.0)])
+
+    @kernel
+    def tangent(self, state):
+        K = assemble(material_tangent, self.basis,
+                     A=self.material.tangent(state["F"]))
+        Finv, J, p = state["Finv_m"], state["J_m"], state["p"]
+        Q = J * np.swapaxes(Finv, 0, 1)  # dJ/dF at the master
+        A = p * _d_JFinvT(J, Finv)
+        nf, m, d = self.S.shape
+        SA = np.einsum("k,kib,cbeLk->kiceL", self.V, self.S, A)
+        uu = np.einsum("kiceL,klL->kicle", SA, self._G0)
+        up = np.einsum("k,kib,cbk->kic", self.V, self.S, Q)  # (nf, m, d)
+        pu = np.einsum("k,eLk,klL->kle", self.V, Q, self._G0)
+        if self._pattern is None:
+            dofs = (d * self.mem[:, :, None] + np.arange(d)).reshape(nf,
+                                                                     m * d)
+            pdof = self.n_u + np.arange(nf)[:, None]
+            rows = [np.broadcast_to(dofs[:, :, None], (nf, m * d, m * d)),
+                    dofs, np.broadcast_to(pdof, (nf, m * d))]
+            cols = [np.broadcast_to(dofs[:, None, :], (nf, m * d, m * d)),
+                    np.broadcast_to(pdof, (nf, m * d)), dofs]
+            self._pattern = FixedPattern(
+                np.concatenate([r.ravel() for r in rows]),
+                np.concatenate([c.ravel() for c in cols]), self.N)
+        K.resize((self.N, self.N))
+        return K + self._pattern.matrix(np.concatenate(
+            [uu.ravel(), up.ravel(), pu.ravel()]))
