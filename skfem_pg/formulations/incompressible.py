@@ -46,6 +46,18 @@ from .dilatation import _d_JFinvT
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 
+def incompressible_shear_modulus(material):
+    """The shear modulus of an incompressible iso/vol neo-Hooke material
+    (:meth:`~skfem_pg.materials.NeoHookeIsoVol.incompressible`); anything
+    else raises."""
+    if not isinstance(material, NeoHookeIsoVol) or np.isfinite(material.K):
+        raise ValueError(
+            "IUnlP0 is the incompressible limit (nu = 0.5): use "
+            "NeoHookeIsoVol.incompressible(mu); for a finite bulk "
+            "modulus use UnlP0 / Q1P0 / H1P0, got {!r}".format(material))
+    return material.mu
+
+
 class IncompressibleP0(Hyperelastic):
     """IUnlP0 on a PBG :class:`~skfem_pg.FamilyBasis`, incompressible
     Q1P0 / H1P0 on a scikit-fem vector basis (see the module docstring);
@@ -68,13 +80,7 @@ class IncompressibleP0(Hyperelastic):
     def of(cls, basis, material):
         """From :meth:`NeoHookeIsoVol.incompressible(mu)
         <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
-        if not isinstance(material, NeoHookeIsoVol) \
-                or np.isfinite(material.K):
-            raise ValueError(
-                "IUnlP0 is the incompressible limit (nu = 0.5): use "
-                "NeoHookeIsoVol.incompressible(mu); for a finite bulk "
-                "modulus use UnlP0 / Q1P0 / H1P0, got {!r}".format(material))
-        return cls(basis, material.mu)
+        return cls(basis, incompressible_shear_modulus(material))
 
     @property
     def N(self):

@@ -185,13 +185,8 @@ class MasterIncompressible(MasterDilatation):
     def of(cls, basis, material):
         """From :meth:`NeoHookeIsoVol.incompressible(mu)
         <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
-        if not isinstance(material, NeoHookeIsoVol) \
-                or np.isfinite(material.K):
-            raise ValueError(
-                "PPG IUnlP0 is the incompressible limit (nu = 0.5): use "
-                "NeoHookeIsoVol.incompressible(mu), got {!r}".format(
-                    material))
-        return cls(basis, material.mu)
+        from .incompressible import incompressible_shear_modulus
+        return cls(basis, incompressible_shear_modulus(material))
 
     @property
     def N(self):
