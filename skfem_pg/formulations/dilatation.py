@@ -58,6 +58,18 @@ def _d_JFinvT(J, Finv):
                 - np.einsum("Jk...,Li...->iJkL...", Finv, Finv))
 
 
+def compressible_moduli(material, formulation):
+    """``(mu, K)`` of an iso/vol neo-Hooke material with a finite bulk
+    modulus, which the condensed and nodal mixed formulations need;
+    anything else raises naming ``formulation``."""
+    if not isinstance(material, NeoHookeIsoVol) \
+            or not np.isfinite(material.K):
+        raise ValueError("{} needs the iso/vol neo-Hooke material "
+                         "(NeoHookeIsoVol) with a finite bulk modulus, got "
+                         "{!r}".format(formulation, material))
+    return material.mu, material.K
+
+
 class MeanDilatation(Hyperelastic):
     """Condensed polynomial pressure and dilatation per element (see the
     module docstring): ``order=0`` is Q1P0 / H1P0 on a scikit-fem vector
@@ -86,12 +98,10 @@ class MeanDilatation(Hyperelastic):
     @classmethod
     def of(cls, basis, material, order=0):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
-        if not isinstance(material, NeoHookeIsoVol):
-            raise ValueError("a mean-dilatation formulation (Q1P0, H1P0, "
-                             "UnlP0, U2P1) needs the iso/vol neo-Hooke "
-                             "material (NeoHookeIsoVol), got {!r}".format(
-                                 material))
-        return cls(basis, material.mu, material.K, order=order)
+        mu, K = compressible_moduli(
+            material, "a mean-dilatation formulation (Q1P0, H1P0, UnlP0, "
+            "U2P1)")
+        return cls(basis, mu, K, order=order)
 
     def project(self, a):
         """Coefficients ``(n, q)`` of the weighted L2 projection of point

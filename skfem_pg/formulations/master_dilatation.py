@@ -38,7 +38,7 @@ from ..discretization.petrov import reverse_slots
 from ..errors import ParticleError
 from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
-from .dilatation import _d_JFinvT
+from .dilatation import _d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, material_tangent
 
 
@@ -67,7 +67,11 @@ class MasterDilatation(Hyperelastic):
         mem, mask = fam.padded()
         self.mem = np.where(mask, mem, mem[:, :1])  # pads -> the master
         self.V = p.volumes[fam.masters]  # V^k per family
-        self._G0 = basis._G[:, 0] * mask[:, :, None]  # trial at the master
+        self._G0 = basis.G[:, 0] * mask[:, :, None]  # trial at the master
+        # the master's own point (k, k) in the flat layout: F^{kk} there
+        self._master_points = np.empty(len(fam.masters), dtype=np.int64)
+        for g in basis.layout:
+            self._master_points[g.families] = g.flat[:, 0]
         # S^k: sum over the bonds (f, q) with mem[f, q] = k of the test
         # derivatives, gathered on family k's slots
         T = basis.test.G  # (nf, m, m, d): T[f, q, 0] = G_t^{kkf}
@@ -86,19 +90,12 @@ class MasterDilatation(Hyperelastic):
     @classmethod
     def of(cls, basis, material):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
-        if not isinstance(material, NeoHookeIsoVol) \
-                or not np.isfinite(material.K):
-            raise ValueError("PPG UnlP0 needs the iso/vol neo-Hooke "
-                             "material with a finite bulk modulus, got "
-                             "{!r}".format(material))
-        return cls(basis, material.mu, material.K)
+        return cls(basis, *compressible_moduli(material, "PPG UnlP0"))
 
-    def _master(self, u):
-        """:math:`F^{kk}` per family, ``(d, d, nf)``."""
-        d = self.S.shape[-1]
-        U = u.reshape(-1, d)[self.mem]  # (nf, m, d)
-        return np.eye(d)[:, :, None] + np.einsum("kic,kib->cbk", U,
-                                                 self._G0)
+    def _master(self, F):
+        """:math:`F^{kk}` per family, ``(d, d, nf)``, from the flat
+        deformation gradients ``F`` ``(d, d, 1, N_q)``."""
+        return F[:, :, 0, self._master_points]
 
     def _volumetric(self, Fm):
         Finv, J = inverse_and_det(Fm)
@@ -109,13 +106,9 @@ class MasterDilatation(Hyperelastic):
     @kernel
     def state(self, u):
         s = super().state(u)
-        Fm = self._master(u)
-        Finv, J, p, Pv = self._volumetric(Fm)
-        s.update(Fm=Fm, Finv_m=Finv, J_m=J, p=p, P_vol=Pv)
+        Finv, J, p, Pv = self._volumetric(self._master(s["F"]))
+        s.update(Finv_m=Finv, J_m=J, p=p, P_vol=Pv)
         return s
-
-    def min_J(self, state):
-        return float(min(super().min_J(state), state["J_m"].min()))
 
     def energy(self, state):
         J = state["J_m"]
@@ -140,26 +133,35 @@ class MasterDilatation(Hyperelastic):
             (d * self.mem[:, :, None] + np.arange(d)).ravel(), loc.ravel(),
             minlength=self.n_u)
 
-    @kernel
-    def tangent(self, state):
+    def _family_dofs(self):
+        """``(nf, m d)`` displacement dofs of each family's members."""
+        nf, m, d = self.S.shape
+        return (d * self.mem[:, :, None] + np.arange(d)).reshape(nf, m * d)
+
+    def _tangent_parts(self, state, A_vol):
+        r""":math:`\sum_{ej} w\,\nabla\delta u : \mathbb A_{iso} :
+        \nabla du` (sparse, ``N × N``) and the one-point blocks
+        :math:`V^k S^k_{ib} \mathbb A_{vol} G^{kkl}_L` ``(nf, m, d, m, d)``
+        of the volumetric stiffness ``A_vol`` at the masters."""
         K = assemble(material_tangent, self.basis,
                      A=self.material.tangent(state["F"]))
+        SA = np.einsum("k,kib,cbeLk->kiceL", self.V, self.S, A_vol)
+        return K, np.einsum("kiceL,klL->kicle", SA, self._G0)
+
+    @kernel
+    def tangent(self, state):
         Finv, J, p = state["Finv_m"], state["J_m"], state["p"]
         Q = J * np.swapaxes(Finv, 0, 1)
         Upp = 0.5 * self.K * (1.0 + 1.0 / J ** 2)
-        A = Upp * Q[:, :, None, None] * Q[None, None] + p * _d_JFinvT(J,
-                                                                    Finv)
-        SA = np.einsum("k,kib,cbeLk->kiceL", self.V, self.S, A)
-        nf, m, d = self.S.shape
-        loc = np.einsum("kiceL,klL->kicle", SA, self._G0)
+        K, uu = self._tangent_parts(state, Upp * Q[:, :, None, None]
+                                    * Q[None, None] + p * _d_JFinvT(J, Finv))
         if self._pattern is None:
-            dofs = (d * self.mem[:, :, None] + np.arange(d)).reshape(nf,
-                                                                     m * d)
-            rows = np.broadcast_to(dofs[:, :, None], (nf, m * d, m * d))
-            cols = np.broadcast_to(dofs[:, None, :], (nf, m * d, m * d))
-            self._pattern = FixedPattern(rows.ravel(), cols.ravel(),
-                                         self.n_u)
-        return K + self._pattern.matrix(loc.ravel())
+            dofs = self._family_dofs()
+            shape = dofs.shape + dofs.shape[-1:]  # (nf, m d, m d)
+            self._pattern = FixedPattern(
+                np.broadcast_to(dofs[:, :, None], shape).ravel(),
+                np.broadcast_to(dofs[:, None, :], shape).ravel(), self.n_u)
+        return K + self._pattern.matrix(uu.ravel())
 
 
 class MasterIncompressible(MasterDilatation):
@@ -208,9 +210,8 @@ class MasterIncompressible(MasterDilatation):
     def state(self, x):
         u, p = self._split(x)
         s = Hyperelastic.state(self, u)
-        Fm = self._master(u)
-        Finv, J = inverse_and_det(Fm)
-        s.update(Fm=Fm, Finv_m=Finv, J_m=J, p=p,
+        Finv, J = inverse_and_det(self._master(s["F"]))
+        s.update(Finv_m=Finv, J_m=J, p=p,
                  P_vol=p * J * np.swapaxes(Finv, 0, 1))
         return s
 
@@ -234,19 +235,14 @@ class MasterIncompressible(MasterDilatation):
 
     @kernel
     def tangent(self, state):
-        K = assemble(material_tangent, self.basis,
-                     A=self.material.tangent(state["F"]))
         Finv, J, p = state["Finv_m"], state["J_m"], state["p"]
         Q = J * np.swapaxes(Finv, 0, 1)  # dJ/dF at the master
-        A = p * _d_JFinvT(J, Finv)
-        nf, m, d = self.S.shape
-        SA = np.einsum("k,kib,cbeLk->kiceL", self.V, self.S, A)
-        uu = np.einsum("kiceL,klL->kicle", SA, self._G0)
+        K, uu = self._tangent_parts(state, p * _d_JFinvT(J, Finv))
         up = np.einsum("k,kib,cbk->kic", self.V, self.S, Q)  # (nf, m, d)
         pu = np.einsum("k,eLk,klL->kle", self.V, Q, self._G0)
         if self._pattern is None:
-            dofs = (d * self.mem[:, :, None] + np.arange(d)).reshape(nf,
-                                                                     m * d)
+            nf, m, d = self.S.shape
+            dofs = self._family_dofs()
             pdof = self.n_u + np.arange(nf)[:, None]
             rows = [np.broadcast_to(dofs[:, :, None], (nf, m * d, m * d)),
                     dofs, np.broadcast_to(pdof, (nf, m * d))]

@@ -50,7 +50,7 @@ from ..discretization.elementwise import Elements
 from ..errors import ParticleError
 from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
-from .dilatation import _d_JFinvT
+from .dilatation import _d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 #: local Newton of the bubble: largest iterations, and the tolerance on
@@ -122,12 +122,8 @@ class NodalPressure(Hyperelastic):
     @classmethod
     def of(cls, basis, material, bubble=True):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
-        if not isinstance(material, NeoHookeIsoVol) \
-                or not np.isfinite(material.K):
-            raise ValueError("U2P1C / Unl+P1C need the iso/vol neo-Hooke "
-                             "material with a finite bulk modulus, got "
-                             "{!r}".format(material))
-        return cls(basis, material.mu, material.K, bubble=bubble)
+        mu, K = compressible_moduli(material, "U2P1C / Unl+P1C")
+        return cls(basis, mu, K, bubble=bubble)
 
     @property
     def N(self):
