@@ -26,7 +26,7 @@ requires ``dim + 1`` non-master members in general position.
 import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
-from ..errors import FamilyError, describe_particle
+from ..errors import FamilyError, ParticleError, describe_particle
 
 
 class Families:
@@ -67,6 +67,18 @@ class Families:
     def masters(self):
         """Master particle of each family."""
         return self.members[self.offsets[:-1]]
+
+    def require_every_master(self, x, what):
+        """Raise :class:`ParticleError` naming the first particle that
+        masters no family (``x`` the particle positions) — for
+        formulations with an unknown at every particle (``what``)."""
+        missing = np.setdiff1d(np.arange(self.n_particles), self.masters)
+        if len(missing):
+            i = int(missing[0])
+            raise ParticleError(
+                "{} masters no family: {} need(s) a family at every "
+                "particle ({} without one)".format(
+                    describe_particle(i, x[:, i]), what, len(missing)))
 
     @property
     def sizes(self):

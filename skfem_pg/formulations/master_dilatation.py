@@ -35,7 +35,6 @@ import numpy as np
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.petrov import reverse_slots
-from ..errors import ParticleError
 from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .dilatation import _d_JFinvT, compressible_moduli
@@ -59,11 +58,7 @@ class MasterDilatation(Hyperelastic):
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
         p, fam = basis.particles, basis.families
-        if len(fam.masters) != p.n:
-            i = int(np.setdiff1d(np.arange(p.n), fam.masters)[0])
-            raise ParticleError(
-                "particle {} at {} masters no family: PPG UnlP0 needs one "
-                "at every particle".format(i, tuple(p.x[:, i])))
+        fam.require_every_master(p.x, "PPG UnlP0 / IUnlP0")
         mem, mask = fam.padded()
         self.mem = np.where(mask, mem, mem[:, :1])  # pads -> the master
         self.V = p.volumes[fam.masters]  # V^k per family

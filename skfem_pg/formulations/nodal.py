@@ -47,7 +47,6 @@ import scipy.sparse as sp
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
-from ..errors import ParticleError
 from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .dilatation import _d_JFinvT, compressible_moduli
@@ -97,16 +96,11 @@ class NodalPressure(Hyperelastic):
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
         self.bubble = bool(bubble)
-        p, fam = basis.particles, basis.families
+        p = basis.particles
         self.n = p.n
-        masters = np.zeros(p.n, dtype=bool)
-        masters[fam.masters] = True
-        if not masters.all():
-            i = int(np.flatnonzero(~masters)[0])
-            raise ParticleError(
-                "particle {} at {} masters no family: nodal p and Theta "
-                "need a family at every particle (U2P1C / Unl+P1C on a "
-                "subdomain is not built)".format(i, tuple(p.x[:, i])))
+        basis.families.require_every_master(
+            p.x, "nodal p and Theta (U2P1C / Unl+P1C on a subdomain is not "
+            "built)")
         self.elements = Elements(basis)
         self.groups = [_Group(g, G, dx, p.x, p.volumes) for g, G, dx in zip(
             basis.layout, basis.grouped_gradients(),
