@@ -148,15 +148,16 @@ def infsup_mixed(model, free, **kw):
     d, nf = basis.particles.dim, basis.layout.n_families
     Sub, Sbb, Bbt = ([], [], []), np.zeros(nf * d), np.zeros((nf * d, n))
     for gr in model.groups:
-        # grad of the bubble e_c (x) b^kj: S_ub = sum_j w G^kji . b^kj
+        # grad of the bubble e_c (x) b^kj: S_ub = sum_j w G^kji . b^kj,
+        # S_bb = sum_j w |b^kj|^2, the same for every component c
         v = np.einsum("kj,kjib,kjb->ki", gr.dx, gr.G, gr.b)
+        bb = np.einsum("kj,kjb,kjb->k", gr.dx, gr.b, gr.b)
+        fam = np.broadcast_to(gr.families[:, None], gr.members.shape)
         for c in range(d):
             Sub[0].append((d * gr.members + c).ravel())
-            Sub[1].append((d * gr.families[:, None] + c
-                           + 0 * gr.members).ravel())
+            Sub[1].append((d * fam + c).ravel())
             Sub[2].append(v.ravel())
-            Sbb[d * gr.families + c] = np.einsum("kj,kjb,kjb->k", gr.dx,
-                                                 gr.b, gr.b)
+            Sbb[d * gr.families + c] = bb
         # div of the bubble: b^kj_c; against Np^kji
         r = np.einsum("kj,kjc,kji->kci", gr.dx, gr.b, gr.Np)
         rows = d * gr.families[:, None, None] + np.arange(d)[:, None]
