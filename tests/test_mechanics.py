@@ -9,16 +9,7 @@ from skfem_pg.formulations import Hyperelastic, MeanDilatation
 from skfem_pg.solvers import newton
 
 
-def annulus(n, a=1.0, b=2.0):
-    """Quarter annulus a <= r <= b, n elements radially, 2n around."""
-    m0 = fem.MeshQuad.init_tensor(np.linspace(a, b, n + 1),
-                                  np.linspace(0, np.pi / 2, 2 * n + 1))
-    mesh = fem.MeshQuad(np.array([m0.p[0] * np.cos(m0.p[1]),
-                                  m0.p[0] * np.sin(m0.p[1])]), m0.t)
-    return mesh.with_boundaries({
-        "inner": lambda x: np.hypot(x[0], x[1]) < a + 0.5 * (b - a) / n,
-        "xaxis": lambda x: np.isclose(x[1], 0),
-        "yaxis": lambda x: np.isclose(x[0], 0)})
+annulus = pg.meshing.annulus
 
 
 @pytest.mark.parametrize("model_of", [

@@ -220,11 +220,11 @@ def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
         if lam == 1.0 and lam - done[0] > 0.05:  # the last bit is hard
             tried.append((done[0], lam, False))
             return False, u, {"residuals": [1.0], "reason": "test",
-                              "min_J": 1.0}
-        ok, u, info = step(model, u, lam, *args)
+                              "min_J": 1.0}, None
+        ok, u, info, state = step(model, u, lam, *args)
         tried.append((done[0], lam, ok))
         done[0] = lam if ok else done[0]
-        return ok, u, info
+        return ok, u, info, state
     monkeypatch.setattr(static, "_newton_step", fails_above)
     f = pg.traction(b, "right", [0.0, 0.01])
     newton(model, f, D=b.get_dofs("left"), predictor=False, verbose=False)

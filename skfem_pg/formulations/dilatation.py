@@ -45,7 +45,7 @@ import numpy as np
 
 from ..discretization.assembly import assemble
 from ..discretization.elementwise import Elements
-from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..materials import J2Plasticity, NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .displacement import Hyperelastic, material_tangent
 
@@ -62,11 +62,12 @@ def compressible_moduli(material, formulation):
     """``(mu, K)`` of an iso/vol neo-Hooke material with a finite bulk
     modulus, which the condensed and nodal mixed formulations need;
     anything else raises naming ``formulation``."""
-    if not isinstance(material, NeoHookeIsoVol) \
+    if not isinstance(material, (NeoHookeIsoVol, J2Plasticity)) \
             or not np.isfinite(material.K):
         raise ValueError("{} needs the iso/vol neo-Hooke material "
-                         "(NeoHookeIsoVol) with a finite bulk modulus, got "
-                         "{!r}".format(formulation, material))
+                         "(NeoHookeIsoVol) or J2Plasticity with a finite "
+                         "bulk modulus, got {!r}".format(formulation,
+                                                         material))
     return material.mu, material.K
 
 
@@ -101,7 +102,7 @@ class MeanDilatation(Hyperelastic):
         mu, K = compressible_moduli(
             material, "a mean-dilatation formulation (Q1P0, H1P0, UnlP0, "
             "U2P1)")
-        return cls(basis, mu, K, order=order)
+        return cls(basis, mu, K, order=order).with_material(material)
 
     def project(self, a):
         """Coefficients ``(n, q)`` of the weighted L2 projection of point

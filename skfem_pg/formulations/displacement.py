@@ -18,6 +18,10 @@ in the state.  For ``x`` a model evaluates
 * ``fields(x)``: the extra fields by name (per element / family),
 * ``initial()``: the unknowns of the undeformed state (zero
   displacements and pressures, unit dilatations),
+* ``commit(state)``: called by the solvers when a step has converged at
+  ``state``; a model with a stateful material (J2 plasticity) makes that
+  state's internal variables the committed ones (``model.history``,
+  :class:`~skfem_pg.formulations.history.History`),
 
 and names its unknowns in ``blocks`` (``(name, slice)``), so that Newton's
 method measures convergence per field.  Loads, Dirichlet dofs and results
@@ -30,6 +34,7 @@ from skfem.helpers import ddot, grad
 
 from ..discretization.assembly import assemble
 from ..threads import kernel
+from .history import History
 from .tangents import fd_tangent
 
 
@@ -76,6 +81,11 @@ class Hyperelastic:
 
     ``tangent="fd"`` builds the tangent by central differences of the
     family forces (family bases only), as correspondence codes do.
+
+    A stateful ``material`` (:class:`~skfem_pg.materials.J2Plasticity`) is
+    bound to the model's integration points: ``model.history`` holds its
+    committed internal variables, per family member :math:`(k, j)` on a
+    family basis, per Gauss point on a scikit-fem basis.
     """
 
     def __init__(self, basis, material, tangent="consistent"):
@@ -89,8 +99,14 @@ class Hyperelastic:
                 "{!r} is incompressible (K = inf): a displacement "
                 "formulation cannot carry it; use the IUnlP0 formulation "
                 "(skfem_pg.formulations.IncompressibleP0)".format(material))
-        self.basis, self.material, self.tangent_kind = basis, material, \
-            tangent
+        if tangent == "fd" and getattr(material, "stateful", False):
+            raise ValueError("the finite-difference tangent evaluates the "
+                             "material at perturbed members; {!r} has a "
+                             "history: use tangent='consistent'".format(
+                                 material))
+        self.basis, self.tangent_kind = basis, tangent
+        self.material = History(material) if getattr(
+            material, "stateful", False) else material
         self.n_u = basis.N
         d = _dim(basis)
         self._eye = np.eye(d).reshape(d, d, 1, 1)
@@ -113,6 +129,43 @@ class Hyperelastic:
     def initial(self):
         """Unknowns of the undeformed, unloaded state."""
         return np.zeros(self.N)
+
+    @property
+    def history(self):
+        """The :class:`~skfem_pg.formulations.history.History` of a
+        stateful material, else ``None``."""
+        return self.material if isinstance(self.material, History) \
+            else None
+
+    def with_material(self, material):
+        """Bind the (isochoric) ``material`` the formulation evaluates at
+        its points — how the mixed formulations take a stateful material
+        whose volumetric part they treat themselves; returns ``self``."""
+        if getattr(material, "stateful", False):
+            self.material = History(material.isochoric())
+        return self
+
+    def commit(self, state):
+        """A step converged at ``state``: commit its internal variables
+        (nothing to do for a hyperelastic material)."""
+        if self.history is not None:
+            self.history.commit(state["F"])
+
+    def plastic_strain(self):
+        """The committed accumulated plastic strain :math:`\\bar e_p`
+        (the hardening variable) per element — its weighted mean over the
+        element's points: per family (particle) on a family basis, per
+        cell on a scikit-fem basis — and its maximum over all points;
+        ``None`` for a material without history."""
+        from ..discretization.elementwise import Elements
+        h = self.history
+        if h is None:
+            return None
+        E = Elements(self.basis)
+        a = h.alpha()
+        if a is None:
+            a = np.zeros(E.point_shape)
+        return E.sum(a) / E.volumes, float(a.max(initial=0.0))
 
     @kernel
     def state(self, u):

@@ -40,7 +40,7 @@ import scipy.sparse as sp
 
 from ..discretization.assembly import assemble
 from ..discretization.elementwise import Elements
-from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..materials import J2Plasticity, NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .dilatation import _d_JFinvT
 from .displacement import Hyperelastic, internal_force, material_tangent
@@ -50,11 +50,13 @@ def incompressible_shear_modulus(material):
     """The shear modulus of an incompressible iso/vol neo-Hooke material
     (:meth:`~skfem_pg.materials.NeoHookeIsoVol.incompressible`); anything
     else raises."""
-    if not isinstance(material, NeoHookeIsoVol) or np.isfinite(material.K):
+    if not isinstance(material, (NeoHookeIsoVol, J2Plasticity)) \
+            or np.isfinite(material.K):
         raise ValueError(
             "IUnlP0 is the incompressible limit (nu = 0.5): use "
-            "NeoHookeIsoVol.incompressible(mu); for a finite bulk "
-            "modulus use UnlP0 / Q1P0 / H1P0, got {!r}".format(material))
+            "NeoHookeIsoVol.incompressible(mu) (or J2Plasticity with "
+            "K = inf); for a finite bulk modulus use UnlP0 / Q1P0 / H1P0, "
+            "got {!r}".format(material))
     return material.mu
 
 
@@ -80,7 +82,8 @@ class IncompressibleP0(Hyperelastic):
     def of(cls, basis, material):
         """From :meth:`NeoHookeIsoVol.incompressible(mu)
         <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
-        return cls(basis, incompressible_shear_modulus(material))
+        return cls(basis, incompressible_shear_modulus(material)
+                   ).with_material(material)
 
     @property
     def N(self):

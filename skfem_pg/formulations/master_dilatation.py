@@ -85,7 +85,8 @@ class MasterDilatation(Hyperelastic):
     @classmethod
     def of(cls, basis, material):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
-        return cls(basis, *compressible_moduli(material, "PPG UnlP0"))
+        return cls(basis, *compressible_moduli(material, "PPG UnlP0")
+                   ).with_material(material)
 
     def _master(self, F):
         """:math:`F^{kk}` per family, ``(d, d, nf)``, from the flat
@@ -183,7 +184,8 @@ class MasterIncompressible(MasterDilatation):
         """From :meth:`NeoHookeIsoVol.incompressible(mu)
         <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
         from .incompressible import incompressible_shear_modulus
-        return cls(basis, incompressible_shear_modulus(material))
+        return cls(basis, incompressible_shear_modulus(material)
+                   ).with_material(material)
 
     @property
     def N(self):

@@ -117,7 +117,7 @@ class NodalPressure(Hyperelastic):
     def of(cls, basis, material, bubble=True):
         """From a :class:`~skfem_pg.materials.NeoHookeIsoVol`."""
         mu, K = compressible_moduli(material, "U2P1C / Unl+P1C")
-        return cls(basis, mu, K, bubble=bubble)
+        return cls(basis, mu, K, bubble=bubble).with_material(material)
 
     @property
     def N(self):

@@ -1,9 +1,11 @@
-"""Material laws as functions of the deformation gradient (hyperelastic
-today), and the checks and conversions of elastic constants."""
+"""Material laws as functions of the deformation gradient: hyperelastic
+(stateless) and finite J2 elasto-plasticity (with history), and the checks
+and conversions of elastic constants."""
 from .constants import check_moduli, lame
 from .hyperelastic import (Material, LinearElastic, StVenantKirchhoff,
                            NeoHooke, NeoHookeIsoVol, inverse_and_det)
+from .plasticity import J2Plasticity, ReturnMapError
 
 __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
-           "inverse_and_det"]
+           "inverse_and_det", "J2Plasticity", "ReturnMapError"]

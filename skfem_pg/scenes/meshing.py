@@ -81,6 +81,21 @@ def cook_membrane(n, kind="quad"):
     })
 
 
+def annulus(n, a=1.0, b=2.0):
+    """Quarter annulus :math:`a \\le r \\le b` of quadrilaterals, ``n``
+    elements radially and ``2n`` around, with the boundaries ``inner``,
+    ``xaxis`` and ``yaxis`` (Lamé's and the thick-walled cylinder's
+    domain)."""
+    m0 = fem.MeshQuad.init_tensor(np.linspace(a, b, n + 1),
+                                  np.linspace(0, np.pi / 2, 2 * n + 1))
+    mesh = fem.MeshQuad(np.array([m0.p[0] * np.cos(m0.p[1]),
+                                  m0.p[0] * np.sin(m0.p[1])]), m0.t)
+    return mesh.with_boundaries({
+        "inner": lambda x: np.hypot(x[0], x[1]) < a + 0.5 * (b - a) / n,
+        "xaxis": lambda x: np.isclose(x[1], 0),
+        "yaxis": lambda x: np.isclose(x[0], 0)})
+
+
 def plate_with_hole(a=1.0, L=5.0, n=8, m=None, ratio=6.0):
     r"""Quarter of a square plate :math:`[-L, L]^2` with a central hole of
     radius ``a``: the part :math:`x, y \ge 0`, structured quadrilaterals

@@ -75,7 +75,9 @@ class Result:
 
     ``u``: the displacements in scikit-fem numbering of ``basis`` (for
     every formulation); ``fields``: the formulation's extra fields by name
-    (e.g. ``p`` and ``Theta`` per element or family for Q1P0 / UnlP0);
+    (e.g. ``p`` and ``Theta`` per element or family for Q1P0 / UnlP0;
+    ``ep``, the accumulated plastic strain, per family or cell for a
+    plastic material);
     ``x``: all unknowns of ``model`` (``u`` first); ``f_ext``: the external
     forces at the end of the load path."""
     method: str
@@ -290,8 +292,12 @@ class Scene:
                  "assemble": sum(h["t_assemble"] for h in hist),
                  "solve": sum(h["t_linear"] for h in hist)}
         u = x[:model.n_u]
+        fields = model.fields(x)
+        plastic = model.plastic_strain()
+        if plastic is not None:  # per family (particle) or per cell
+            fields["ep"] = plastic[0]
         return Result(scheme, u, basis, self.evaluate(basis, u), times, hist,
-                      fields=model.fields(x), model=model, x=x, f_ext=f)
+                      fields=fields, model=model, x=x, f_ext=f)
 
     def setup(self, scheme="PG", mesh=None, tangent="consistent",
               **basis_kwargs):

@@ -5,7 +5,9 @@ Newton drives a model of :mod:`skfem_pg.formulations`: residual
 :math:`\partial f_{int}/\partial u`.
 
 Load stepping: the load factor :math:`\lambda` goes from 0 to 1 (external
-forces and prescribed displacements are scaled).  A step is cut in half when
+forces and prescribed displacements are scaled).  A converged step is
+committed (``model.commit``: the internal variables of a plastic material);
+a failed one is not, so the history after it is the last converged one.  A step is cut in half when
 Newton diverges, exceeds ``maxiter`` or meets :math:`J \le 0` anywhere; a
 :class:`ConvergenceError` names the load factor once the step would fall
 below ``min_step``.
@@ -15,6 +17,7 @@ import time
 import numpy as np
 
 from ..dofs import as_dofs, check_sliding
+from ..materials import ReturnMapError
 from .linear import linear_solver
 
 
@@ -56,7 +59,7 @@ def _condensed_solver(kind, basis, I, extra_fields=False):
 
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           adaptive=True, predictor=True, verbose=True):
+           adaptive=True, predictor=True, verbose=True, load0=0.0):
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
@@ -104,6 +107,9 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         ``False``: ``steps`` equal steps, and a failed one raises
         :class:`ConvergenceError` at once (robustness studies: the largest
         step that converges).
+    load0
+        The load factor of ``u0``: resume a run there (with a model
+        whose history was restored, :mod:`skfem_pg.solvers.checkpoint`).
     predictor
         Start each load step from the linear extrapolation of the last two
         converged states (secant predictor) instead of the last one; a
@@ -141,7 +147,10 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     lin = solver if callable(solver) else _condensed_solver(
         solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
-    lam, dlam = 0.0, 1.0 / steps
+    lam = float(load0)
+    if not 0.0 <= lam <= 1.0:
+        raise ValueError("load0 must lie in [0, 1], got {}".format(load0))
+    dlam = (1.0 - lam) / steps if lam < 1.0 else 1.0
     prev = None  # (load, u) of the converged step before the last
     history = []
     while lam < 1.0 - 1e-14:
@@ -151,9 +160,9 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         if predictor and prev is not None:
             start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
         n_krylov = len(stats["iterations"])
-        ok, uk, info = _newton_step(model, start, target, f_ext, Dd,
-                                    prescribed(target)[Dd], I, lin, tol,
-                                    maxiter)
+        ok, uk, info, state = _newton_step(model, start, target, f_ext, Dd,
+                                           prescribed(target)[Dd], I, lin,
+                                           tol, maxiter)
         info.update(load=target, seconds=time.perf_counter() - t0,
                     krylov=stats["iterations"][n_krylov:])
         if verbose:
@@ -167,6 +176,8 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
                                for r in info["residuals"]),
                       info["min_J"]), flush=True)
         if ok:
+            if hasattr(model, "commit"):  # history of a converged step
+                model.commit(state)
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
@@ -237,34 +248,38 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
     small = False
     for it in range(maxiter + 1):
         t0 = time.perf_counter()
-        state = model.state(u)
+        try:
+            state = model.state(u)
+        except ReturnMapError as err:  # a plastic point that cannot return
+            info["reason"] = "return map: {}".format(err)
+            return False, u, info, None
         info["min_J"] = model.min_J(state)
         if not info["min_J"] > 0:
             info["reason"] = "J <= 0"
-            return False, u, info
+            return False, u, info, None
         r = model.internal_force(state) - lam * f_ext
         info["t_assemble"] += time.perf_counter() - t0
         rn = float(np.linalg.norm(r[I]))
         res.append(rn)
         if not np.isfinite(rn):
             info["reason"] = "non-finite residual"
-            return False, u, info
+            return False, u, info, None
         if not pending:
             if ref is None:
                 ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
             if rn <= tol * ref or small or (
                     len(energy) > 1 and energy[-1] <= tol ** 2 * energy[0]):
-                return True, u, info
+                return True, u, info, state
             if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
                     and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
                 info["reason"] = "round-off floor"  # converged
-                return True, u, info
+                return True, u, info, state
             if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
                 info["reason"] = "diverging"
-                return False, u, info
+                return False, u, info, None
         if it == maxiter:
             info["reason"] = "maxiter"
-            return False, u, info
+            return False, u, info, None
         t0 = time.perf_counter()
         K = model.tangent(state).tocsr()
         t1 = time.perf_counter()
@@ -281,4 +296,4 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
         small = _small_increment(model, du, u)
         pending = False
     info["reason"] = "maxiter"
-    return False, u, info
+    return False, u, info, None

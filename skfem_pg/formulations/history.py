@@ -1,0 +1,104 @@
+r"""History variables at a model's integration points (thesis 4.4.2).
+
+A stateful material (:class:`~skfem_pg.materials.J2Plasticity`) evaluates
+the stress from the deformation gradient *and* the internal variables of the
+last converged step.  :class:`History` binds it to the points at which a
+formulation evaluates its material — per family member :math:`(k, j)` for
+the fully integrated PG formulations (the flat layout ``(1, N_q)``), per
+Gauss point ``(n_elements, n_qp)`` for FE — and offers the formulation the
+interface of a stateless material (``stress(F)``, ``tangent(F)``,
+``energy(F)``), so every formulation carries plasticity unchanged.
+
+* ``committed``: the internal variables of the last converged step; every
+  evaluation starts from them (a Newton iteration never changes them);
+* :meth:`commit`: after a converged step, the response at that step's
+  ``F`` becomes the committed state; a step that Newton cuts is simply not
+  committed, so the state after a failed step is the last converged one
+  exactly (rollback);
+* :meth:`save` / :meth:`restore`: copies of the committed arrays, which a
+  checkpoint stores with the solution (:mod:`skfem_pg.solvers.checkpoint`).
+
+The last response is cached (keyed on the identity of ``F``), so the
+stress and the tangent at one state cost one return map.
+"""
+import numpy as np
+
+
+class History:
+    """The committed internal variables of ``material`` at a model's
+    points; allocated on the first evaluation (the points' shape is that of
+    ``F.shape[2:]``)."""
+
+    stateful = True
+
+    def __init__(self, material):
+        if not getattr(material, "stateful", False):
+            raise TypeError("{!r} has no history".format(material))
+        self.material = material
+        self.committed = None
+        self._last = None  # (F, response)
+
+    def __repr__(self):
+        return "History({!r})".format(self.material)
+
+    @property
+    def K(self):
+        return self.material.K
+
+    def _check(self, F):
+        shape = F.shape[2:]
+        if self.committed is None:
+            self.committed = self.material.initial_history(shape)
+        elif self.committed["alpha"].shape != shape:
+            raise ValueError(
+                "the history of {!r} lives at points of shape {}, F has {}: "
+                "a plastic material is evaluated only at the model's "
+                "integration points".format(
+                    self.material, self.committed["alpha"].shape, shape))
+
+    def response(self, F):
+        """The material's response to ``F`` from the committed state."""
+        if self._last is not None and self._last[0] is F:
+            return self._last[1]
+        self._check(F)
+        r = self.material.update(F, self.committed)
+        self._last = (F, r)
+        return r
+
+    # the stateless-material interface the formulations call
+    def stress(self, F):
+        return self.response(F).P
+
+    def tangent(self, F):
+        return self.response(F).tangent()
+
+    def energy(self, F):
+        return self.response(F).energy()
+
+    # -- steps ---------------------------------------------------------
+    def commit(self, F):
+        """Make the response at ``F`` (a converged step) the committed
+        state."""
+        r = self.response(F)
+        self.committed = {k: v.copy() for k, v in r.history.items()}
+        self._last = None
+
+    def save(self):
+        """Copies of the committed arrays (``None`` before any
+        evaluation)."""
+        if self.committed is None:
+            return None
+        return {k: v.copy() for k, v in self.committed.items()}
+
+    def restore(self, saved):
+        """Set the committed state to ``saved`` (from :meth:`save`)."""
+        self.committed = None if saved is None else {
+            k: np.array(v, dtype=float) for k, v in saved.items()}
+        self._last = None
+
+    def alpha(self):
+        """The committed hardening variable (the accumulated plastic
+        strain) at the points."""
+        if self.committed is None:
+            return None
+        return self.committed["alpha"]

@@ -1,0 +1,424 @@
+r"""Finite-strain J2 elasto-plasticity (thesis 2.3.2, (2.46)–(2.54)) with the
+exponential return map (4.41), batched over all integration points.
+
+Multiplicative split :math:`F = F_e F_p` with isochoric plastic flow
+(:math:`J_p = 1`, (2.13)); the history is :math:`C_p^{-1}` (symmetric,
+(2.17)) and the hardening variable :math:`\alpha` (= the accumulated
+plastic strain :math:`\bar e_p`, since :math:`|n_F| = \sqrt{3/2}`).
+
+* Elastic part (2.46), neo-Hooke with the iso/vol split:
+  :math:`W = \frac\mu2(\mathrm{tr}\,\bar b_e - 3) + \frac K4(J^2 - 1 - 2\ln
+  J)`, :math:`\bar b_e = J^{-2/3} F C_p^{-1} F^T` (2.16); Kirchhoff stress
+  :math:`\tau = \mu\,\mathrm{dev}\,\bar b_e + \frac K2(J^2 - 1) I`,
+  :math:`P = \tau F^{-T}` (2.47), (2.48).
+* Yield function (2.49), (2.50): :math:`\phi = \sigma_{vM}(\tau) -
+  \sigma_y(\alpha)`, :math:`\sigma_{vM} = \sqrt{\tfrac32\,\tau_{dev}:
+  \tau_{dev}}`, :math:`\sigma_y = \sigma_{y0} + H\alpha + (\sigma_{y\infty}
+  - \sigma_{y0})(1 - e^{-\delta\alpha})`.
+* Flow (2.51), (2.52): :math:`n = \partial\phi/\partial\tau = \tfrac32
+  \tau_{dev}/\sigma_{vM}`, :math:`\dot C_p^{-1} = -2\dot\lambda F^{-1} n F
+  C_p^{-1}`, :math:`\dot\alpha = \dot\lambda`.
+* Exponential integration (4.41) *with the minus sign that (2.52)
+  requires* (the printed (4.41) lost it; ``thesis-remaining.md`` A1):
+  :math:`C_p^{-1} = F^{-1}\exp(-2\Delta\alpha\, n) F C_{p,n}^{-1}`, i.e.
+  :math:`b_e = \exp(-2\Delta\alpha\, n)\, b_e^{tr}` with the trial
+  :math:`b_e^{tr} = F C_{p,n}^{-1} F^T`.  As :math:`n` is an isotropic
+  function of :math:`b_e`, all three are coaxial: in the eigenbasis of
+  :math:`b_e^{tr}` (eigenvalues :math:`\beta_A`) the return map is, with
+  :math:`x_A = \ln b_{e,A}`,
+
+  .. math:: x_A - \ln\beta_A + 2\Delta\alpha\, n_A(x) = 0, \qquad
+            \sigma_{vM}(x) - \sigma_y(\alpha_n + \Delta\alpha) = 0,
+
+  four equations per plastic point, solved by a batched local Newton (no
+  loop over points).  The exponential keeps :math:`\det b_e = J^2`
+  (isochoric flow) to round-off.
+* Algorithmic tangent: implicit differentiation of the local equations
+  gives :math:`\partial\tau_A/\partial\beta_B`; the spectral formula
+  :math:`\mathbb D = \sum_{AB}\partial_{\beta_B}\tau_A\, m_A\otimes m_B +
+  \sum_{A\ne B}\frac{\tau_A - \tau_B}{\beta_A - \beta_B}\, m_{AB}`
+  (its limit :math:`\partial_{\beta_A}\tau_A - \partial_{\beta_B}\tau_A` at
+  equal eigenvalues, as in homogeneous uniaxial states), then
+  :math:`\mathbb A_{iJkL} = 2\mathbb D_{imkb}(FC_{p,n}^{-1})_{bL}
+  F^{-1}_{Jm} - P_{iL}F^{-1}_{Jk}` plus the volumetric part.  Checked
+  against central differences of the stress update in
+  ``tests/test_plasticity.py``.
+
+In 2-D the state is plane strain: :math:`F_{33} = 1`, and the
+out-of-plane component of :math:`C_p^{-1}` evolves with the others.
+"""
+import numpy as np
+
+from .constants import check_moduli
+from .hyperelastic import Material, NeoHookeIsoVol, inverse_and_det
+
+#: local Newton: tolerance on the scaled residual and iteration limit
+RETURN_TOL = 1e-12
+RETURN_MAXITER = 50
+#: relative eigenvalue gap below which the spectral tangent uses the
+#: equal-eigenvalue limit (error ~ gap^2 either way)
+EIGEN_GAP = 1e-6
+
+
+class ReturnMapError(RuntimeError):
+    """The local Newton of the return map did not converge; ``points`` are
+    the flat indices of the integration points concerned."""
+
+    def __init__(self, message, points=()):
+        super().__init__(message)
+        self.points = np.asarray(points)
+
+
+class J2Plasticity(Material):
+    r"""Finite J2 elasto-plasticity with neo-Hooke elasticity, von Mises
+    yield and linear plus saturation hardening (module docstring).
+
+    Parameters (the thesis' symbols, (2.46)–(2.49))
+    ----------
+    mu, K
+        Shear and bulk modulus of the elastic part.
+    sigma_y0
+        Initial yield stress.
+    H
+        Linear hardening modulus.
+    sigma_yinf
+        Saturation yield stress (default ``sigma_y0``: no saturation).
+    delta
+        Saturation exponent.
+
+    A stateful material: :meth:`initial_history` gives the history at a
+    set of points and :meth:`update` the response to ``F`` from a
+    committed history.  The formulations bind it to their integration
+    points (:class:`~skfem_pg.formulations.history.History`).
+    """
+
+    stateful = True
+
+    def __init__(self, mu, K, sigma_y0, H=0.0, sigma_yinf=None, delta=0.0):
+        if np.isfinite(K):
+            self.mu, self.K = check_moduli(mu=mu, K=K)
+        else:
+            self.mu, self.K = check_moduli(mu=mu)[0], np.inf
+        self.sigma_y0 = float(sigma_y0)
+        self.H = float(H)
+        self.sigma_yinf = float(sigma_y0 if sigma_yinf is None
+                                else sigma_yinf)
+        self.delta = float(delta)
+        if not self.sigma_y0 > 0:
+            raise ValueError("sigma_y0 must be positive, got {}".format(
+                sigma_y0))
+        if self.H < 0 or self.delta < 0:
+            raise ValueError("H and delta must be >= 0 (softening is not "
+                             "built), got H = {}, delta = {}".format(H, delta))
+        if self.sigma_yinf < self.sigma_y0:
+            raise ValueError("sigma_yinf ({}) below sigma_y0 ({}) would "
+                             "soften".format(sigma_yinf, sigma_y0))
+
+    @classmethod
+    def from_young(cls, E, nu, sigma_y0, **kw):
+        """From Young's modulus and Poisson's ratio."""
+        E, nu = check_moduli(E=E, nu=nu)
+        mu = E / (2 * (1 + nu))
+        return cls(mu, E / (3 * (1 - 2 * nu)), sigma_y0, **kw)
+
+    def isochoric(self):
+        """The same law without the volumetric part (``K = 0``), for the
+        mixed formulations that add it per element or particle; the
+        return map does not depend on ``K``."""
+        m = J2Plasticity(self.mu, 1.0, self.sigma_y0, self.H,
+                         self.sigma_yinf, self.delta)
+        m.K = 0.0
+        return m
+
+    def elastic(self):
+        """The elastic part alone, :class:`NeoHookeIsoVol` (2.46)."""
+        m = NeoHookeIsoVol(self.mu, 1.0)
+        m.K = self.K
+        return m
+
+    # -- hardening -----------------------------------------------------
+    def yield_stress(self, alpha):
+        """:math:`\\sigma_y(\\alpha)` (2.49)."""
+        a = np.asarray(alpha, dtype=float)
+        return (self.sigma_y0 + self.H * a + (self.sigma_yinf - self.sigma_y0)
+                * (1.0 - np.exp(-self.delta * a)))
+
+    def _hardening_slope(self, a):
+        return self.H + (self.sigma_yinf - self.sigma_y0) * self.delta * \
+            np.exp(-self.delta * a)
+
+    # -- history -------------------------------------------------------
+    def initial_history(self, point_shape):
+        """The virgin state at points of shape ``point_shape``:
+        ``Cp_inv`` ``(3, 3, *point_shape)`` the identity, ``alpha`` zero."""
+        n = int(np.prod(point_shape))
+        Cp = np.zeros((3, 3, n))
+        for a in range(3):
+            Cp[a, a] = 1.0
+        return {"Cp_inv": Cp.reshape((3, 3) + tuple(point_shape)),
+                "alpha": np.zeros(tuple(point_shape))}
+
+    # -- the stress update ---------------------------------------------
+    def update(self, F, history):
+        """The response to ``F`` ``(d, d, ...)`` from the committed
+        ``history`` at the same points: a :class:`Response` with the
+        stress ``P``, the trial history and (on demand) the algorithmic
+        tangent."""
+        return Response(self, F, history)
+
+    # stateless use (the virgin state): what the elastic formulations and
+    # the hyperelastic checks call
+    def stress(self, F):
+        return self.update(F, self.initial_history(F.shape[2:])).P
+
+    def tangent(self, F):
+        return self.update(F, self.initial_history(F.shape[2:])).tangent()
+
+    def energy(self, F, history=None):
+        """Stored elastic energy :math:`W(\\bar b_e, J)` (2.46)."""
+        h = self.initial_history(F.shape[2:]) if history is None \
+            else history
+        return self.update(F, h).energy()
+
+    # -- principal-space pieces ---------------------------------------
+    def _tau(self, x):
+        """Deviatoric principal Kirchhoff stress of log stretches ``x``
+        ``(n, 3)`` and its derivatives ``T[n, A, B] = d tau_A / d x_B``."""
+        xb = x - x.mean(axis=1, keepdims=True)
+        bb = np.exp(xb)
+        tau = self.mu * (bb - bb.mean(axis=1, keepdims=True))
+        dbb = bb[:, :, None] * (np.eye(3) - 1.0 / 3.0)
+        T = self.mu * (dbb - dbb.mean(axis=1, keepdims=True))
+        return tau, T
+
+    def _local_residual(self, x, da, xtr, alpha_n):
+        tau, T = self._tau(x)
+        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
+        s = np.maximum(s, 1e-300)
+        nA = 1.5 * tau / s[:, None]
+        ds = 1.5 * np.einsum("na,nab->nb", tau, T) / s[:, None]
+        dn = 1.5 * (T / s[:, None, None]
+                    - tau[:, :, None] * ds[:, None, :] / s[:, None, None] ** 2)
+        a = alpha_n + da
+        R = np.empty((x.shape[0], 4))
+        R[:, :3] = x - xtr + 2 * da[:, None] * nA
+        R[:, 3] = (s - self.yield_stress(a)) / self.mu
+        Jl = np.empty((x.shape[0], 4, 4))
+        Jl[:, :3, :3] = np.eye(3) + 2 * da[:, None, None] * dn
+        Jl[:, :3, 3] = 2 * nA
+        Jl[:, 3, :3] = ds / self.mu
+        Jl[:, 3, 3] = -self._hardening_slope(a) / self.mu
+        return R, Jl, tau, T
+
+    def _radial_start(self, xtr, alpha_n, iterations=40):
+        r"""The start of the local Newton: the return along the trial
+        direction, :math:`x = x^{tr} - 2\Delta\alpha\, n^{tr}`, with
+        :math:`\sigma_{vM}(x) = \sigma_y(\alpha_n + \Delta\alpha)` solved
+        by a bracketed Newton in :math:`[0, \Delta\alpha_{max}]` (where
+        the deviator along :math:`n^{tr}` vanishes).  Exact for fixed
+        principal directions (uniaxial, radial loading); a linear
+        estimate :math:`\phi/(3\bar\mu + H')` overshoots at large steps
+        (neo-Hooke stiffens) and can flip the flow direction."""
+        tau, _ = self._tau(xtr)
+        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
+        ntr = 1.5 * tau / s[:, None]
+        xdev = xtr - xtr.mean(axis=1, keepdims=True)
+        hi = np.sum(xdev * ntr, axis=1) / 3.0  # (x_dev . n) / (2 |n|^2)
+        lo = np.zeros_like(hi)
+        da = 0.5 * hi
+        for _ in range(iterations):
+            x = xtr - 2 * da[:, None] * ntr
+            t, T = self._tau(x)
+            sv = np.sqrt(1.5 * np.sum(t ** 2, axis=1))
+            g = sv - self.yield_stress(alpha_n + da)
+            lo = np.where(g > 0, da, lo)
+            hi = np.where(g > 0, hi, da)
+            dg = (1.5 * np.einsum("na,nab,nb->n", t, T, -2 * ntr)
+                  / np.maximum(sv, 1e-300)
+                  - self._hardening_slope(alpha_n + da))
+            new = da - g / np.where(dg < 0, dg, -1.0)
+            outside = ~((new > lo) & (new < hi))
+            da = np.where(outside, 0.5 * (lo + hi), new)
+            if np.abs(g).max() <= 1e-3 * RETURN_TOL * self.mu:
+                break
+        return xtr - 2 * da[:, None] * ntr, da
+
+    def return_map(self, xtr, alpha_n):
+        """Principal log elastic stretches ``x`` ``(n, 3)`` and increments
+        ``dalpha`` of the plastic points whose trial log stretches are
+        ``xtr`` ``(n, 3)``, and the local Jacobians ``(n, 4, 4)`` at the
+        solution (for the tangent)."""
+        n = xtr.shape[0]
+        x, da = self._radial_start(xtr, alpha_n)
+        todo = np.arange(n)
+        Jl_all = np.empty((n, 4, 4))
+        for it in range(RETURN_MAXITER):
+            R, Jl, _, _ = self._local_residual(x[todo], da[todo], xtr[todo],
+                                               alpha_n[todo])
+            err = np.abs(R).max(axis=1)
+            done = err <= RETURN_TOL
+            Jl_all[todo[done]] = Jl[done]
+            todo, R, Jl = todo[~done], R[~done], Jl[~done]
+            if todo.size == 0:
+                return x, da, Jl_all
+            step = np.linalg.solve(Jl, -R[..., None])[..., 0]
+            # a step may not make dalpha negative (the yield surface
+            # would be left on the wrong side)
+            t = np.ones(todo.size)
+            neg = da[todo] + step[:, 3] < 0
+            t[neg] = 0.5 * da[todo][neg] / np.maximum(-step[neg, 3], 1e-300)
+            x[todo] += t[:, None] * step[:, :3]
+            da[todo] += t * step[:, 3]
+        raise ReturnMapError(
+            "J2 return map: no convergence in {} local Newton iterations at "
+            "{} point(s) (first: {}; trial log stretches {})".format(
+                RETURN_MAXITER, todo.size, todo[0], xtr[todo[0]]), todo)
+
+
+def _embed3(F):
+    """``(n, 3, 3)`` deformation gradients from ``(d, d, n)`` (plane strain
+    in 2-D: :math:`F_{33} = 1`)."""
+    d, n = F.shape[0], F.shape[2]
+    if d == 3:
+        return np.ascontiguousarray(np.moveaxis(F, 2, 0))
+    F3 = np.zeros((n, 3, 3))
+    F3[:, :d, :d] = np.moveaxis(F, 2, 0)
+    F3[:, 2, 2] = 1.0
+    return F3
+
+
+class Response:
+    """The stress update of :class:`J2Plasticity` at a set of points:
+    ``P`` (``(d, d, ...)``), the trial ``history`` (what a converged step
+    commits), ``plastic`` (where the step yields), :meth:`tangent` and
+    :meth:`energy`."""
+
+    def __init__(self, material, F, history):
+        self.material = m = material
+        self.F = F
+        d = F.shape[0]
+        if d not in (2, 3) or F.shape[1] != d:
+            raise ValueError("J2Plasticity needs F of shape (d, d, ...) with "
+                             "d = 2 (plane strain) or 3, got {}".format(
+                                 F.shape))
+        self.point_shape = F.shape[2:]
+        n = int(np.prod(self.point_shape))
+        Cp = history["Cp_inv"].reshape(3, 3, n)
+        alpha_n = history["alpha"].reshape(n)
+        if Cp.shape[2] != n:
+            raise ValueError("history of {} points for F at {}".format(
+                Cp.shape[2], n))
+        F3 = _embed3(F.reshape(d, d, n))
+        # non-finite F (a failed local solve upstream): NaN stresses
+        # there, so that the caller's step is cut
+        bad = ~np.all(np.isfinite(F3), axis=(1, 2))
+        if bad.any():
+            F3[bad] = np.eye(3)
+        self._F3 = F3
+        Cpn = np.moveaxis(Cp, 2, 0)
+        self._G = F3 @ Cpn  # F C_p,n^-1
+        btr = self._G @ np.swapaxes(F3, 1, 2)
+        btr = 0.5 * (btr + np.swapaxes(btr, 1, 2))
+        beta, Q = np.linalg.eigh(btr)
+        if not np.all(beta > 0):
+            neg = np.flatnonzero(~np.all(beta > 0, axis=1))
+            raise ReturnMapError(
+                "J2Plasticity: b_e^tr not positive definite at {} point(s) "
+                "(first {}): F inverted".format(neg.size, neg[0]), neg)
+        xtr = np.log(beta)
+        tau, T = m._tau(xtr)
+        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
+        plastic = s - m.yield_stress(alpha_n) > 0
+        x = xtr.copy()
+        dxdx = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        alpha = alpha_n.copy()
+        if np.any(plastic):
+            xp, da, Jl = m.return_map(xtr[plastic], alpha_n[plastic])
+            x[plastic] = xp
+            alpha[plastic] += da
+            # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
+            dxdx[plastic] = np.linalg.inv(Jl)[:, :3, :3]
+            tau[plastic], T[plastic] = m._tau(xp)
+        self.plastic = plastic.reshape(self.point_shape)
+        Finv3, J = inverse_and_det(np.moveaxis(F3, 0, -1))
+        self._Finv = np.moveaxis(Finv3, -1, 0)  # (n, 3, 3)
+        self.J = J
+        self._beta, self._Q, self._x = beta, Q, x
+        self._tau_dev, self._dtdx = tau, T @ dxdx  # d tau_A / d xtr_B
+        vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
+        self._vol = vol
+        tau_full = np.einsum("nia,na,nma->nim", Q, tau, Q)
+        P3 = (tau_full + vol[:, None, None] * np.eye(3)) @ \
+            np.swapaxes(self._Finv, 1, 2)
+        self._P3 = P3
+        P3[bad] = np.nan
+        self.P = np.moveaxis(P3[:, :d, :d], 0, 2).reshape(
+            (d, d) + self.point_shape)
+        be = np.einsum("nia,na,nma->nim", Q, np.exp(x), Q)
+        Cp_new = self._Finv @ be @ np.swapaxes(self._Finv, 1, 2)
+        Cp_new = 0.5 * (Cp_new + np.swapaxes(Cp_new, 1, 2))
+        self.history = {
+            "Cp_inv": np.moveaxis(Cp_new, 0, 2).reshape(
+                (3, 3) + self.point_shape),
+            "alpha": alpha.reshape(self.point_shape)}
+        self._A = None
+
+    def energy(self):
+        """Stored elastic energy density at the points."""
+        m = self.material
+        xb = self._x - self._x.mean(axis=1, keepdims=True)
+        W = 0.5 * m.mu * (np.exp(xb).sum(axis=1) - 3)
+        if m.K > 0:
+            J = self.J
+            W = W + 0.25 * m.K * (J ** 2 - 1 - 2 * np.log(J))
+        return W.reshape(self.point_shape)
+
+    def tangent(self):
+        r""":math:`\mathbb A_{iJkL} = \partial P_{iJ}/\partial F_{kL}` of the
+        stress update (the algorithmic tangent), ``(d, d, d, d, ...)``."""
+        if self._A is None:
+            self._A = self._tangent()
+        return self._A
+
+    def _tangent(self):
+        m = self.material
+        beta, Q, tau = self._beta, self._Q, self._tau_dev
+        n = beta.shape[0]
+        t = self._dtdx / beta[:, None, :]  # d tau_A / d beta_B
+        # the spectral (shear) coefficients theta_AB, A != B
+        Dp = np.zeros((n, 3, 3, 3, 3))
+        for A in range(3):
+            for B in range(3):
+                Dp[:, A, A, B, B] = t[:, A, B]
+        scale = beta.max(axis=1)
+        for A, B in ((0, 1), (0, 2), (1, 2)):
+            gap = beta[:, A] - beta[:, B]
+            close = np.abs(gap) <= EIGEN_GAP * scale
+            safe = np.where(close, 1.0, gap)
+            th = np.where(close, 0.5 * (t[:, A, A] - t[:, A, B]
+                                        + t[:, B, B] - t[:, B, A]),
+                          (tau[:, A] - tau[:, B]) / safe)
+            for (a, b) in ((A, B), (B, A)):
+                Dp[:, a, b, a, b] += 0.5 * th
+                Dp[:, a, b, b, a] += 0.5 * th
+        # rotate to the reference axes: D_imab = Q_iA Q_mB Q_aC Q_bD D'_ABCD
+        D = np.einsum("niA,nABCD->niBCD", Q, Dp)
+        D = np.einsum("nmB,niBCD->nimCD", Q, D)
+        D = np.einsum("naC,nimCD->nimaD", Q, D)
+        D = np.einsum("nbD,nimaD->nimab", Q, D)
+        # A_iJkL = 2 D_imkb G_bL Finv_Jm - P_iL Finv_Jk  (+ volumetric)
+        E = np.einsum("nimkb,nbL->nimkL", D, self._G)
+        Finv = self._Finv
+        A = 2 * np.einsum("nimkL,nJm->niJkL", E, Finv)
+        P3 = self._P3
+        A -= np.einsum("niL,nJk->niJkL", P3, Finv)
+        if m.K > 0:
+            J2 = self.J ** 2
+            FinvT = np.swapaxes(Finv, 1, 2)
+            # d[(K/2)(J^2 - 1) F^-T]: K J^2 F^-T x F^-T; the -F^-1 F^-1
+            # part is in -P_iL Finv_Jk already
+            A += m.K * J2[:, None, None, None, None] * \
+                FinvT[:, :, :, None, None] * FinvT[:, None, None, :, :]
+        d = self.F.shape[0]
+        A = A[:, :d, :d, :d, :d]
+        return np.moveaxis(A, 0, -1).reshape((d,) * 4 + self.point_shape)
