@@ -250,3 +250,55 @@ def test_checkpoint_resumes_a_run(tmp_path):
         checkpoint.load(tmp_path / "run.npz",
                         model_for("Unl", pg.FamilyBasis(cube(3), dim=3),
                                   STEEL))
+
+
+def plane_strain_uniaxial(m, loads, stretch):
+    """The single-point law along the load factors ``loads``: plane strain
+    ``F = diag(1 + (stretch - 1) t, l)``, the lateral stretch ``l`` with
+    zero lateral stress (``K = inf``: ``l = 1/lambda`` and the pressure
+    takes up the lateral stress).  Returns ``(alpha, P11)``."""
+    iso = m.isochoric() if not np.isfinite(m.K) else m
+    h = iso.initial_history((1,))
+    lt = 1.0
+    for t in loads:
+        lam = 1 + (stretch - 1) * t
+        if not np.isfinite(m.K):
+            F = np.diag([lam, 1 / lam])[:, :, None]
+            r = iso.update(F, h)
+            tau = r.P[:, :, 0] @ F[:, :, 0].T
+            P11 = (tau[0, 0] - tau[1, 1]) / lam
+        else:
+            for _ in range(30):
+                F = np.diag([lam, lt])[:, :, None]
+                r = iso.update(F, h)
+                if abs(r.P[1, 1, 0]) < 1e-14:
+                    break
+                lt -= r.P[1, 1, 0] / r.tangent()[1, 1, 1, 1, 0]
+            P11 = r.P[0, 0, 0]
+        h = r.history
+    return h["alpha"][0], P11
+
+
+@pytest.mark.parametrize("name,incompressible", [
+    ("VCPBG V3m U2", False), ("VCPBG V3m U2P1", False),
+    ("VCPBG V3m U2P1C", False), ("VCBCPPG V3m UnlP0", False),
+    ("VCPBG V5m IUnlP0", True), ("VCBCPPG V3m IUnlP0", True),
+    ("FEM Q1P0", True)])
+def test_every_mixed_formulation_carries_plasticity(name, incompressible):
+    """Homogeneous plane-strain tension to stretch 1.2 (compressible and
+    nu = 0.5): plastic strain and force equal the single-point law along
+    the same load steps."""
+    m = STEEL if not incompressible else J2Plasticity(
+        STEEL.mu, np.inf, STEEL.sigma_y0, H=STEEL.H,
+        sigma_yinf=STEEL.sigma_yinf, delta=STEEL.delta)
+    mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 6)] * 2)
+    sc = Scene("plane strain tension", mesh.with_defaults(), m, steps=4,
+               prescribed={"left": {0: 0.0}, "bottom": {1: 0.0},
+                           "right": {0: 0.2}})
+    r = sc.solve(name)
+    alpha, P11 = plane_strain_uniaxial(m, [h["load"] for h in r.history],
+                                       1.2)
+    ep, ep_max = r.model.plastic_strain()
+    assert alpha > 0.1
+    assert np.abs(ep - alpha).max() < 1e-8
+    assert abs(r.reaction("right")[0] - P11) < 1e-7 * P11
