@@ -19,6 +19,9 @@ The model interface (fields, residual, tangent) is described in
 ``nodal``              :class:`NodalPressure`: nodal p and Theta as global
                        unknowns — PBG U2P1C, Unl+P1C (a condensed bubble)
 ``by_name``            the model of a Table 7.1 formulation token
+``history``            :class:`History`: a plastic material's internal
+                       variables at a model's integration points,
+                       committed per converged step
 ``tangents``           finite-difference tangent of family forces
 =====================  ====================================================
 """
@@ -30,9 +33,10 @@ from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 from .by_name import model_for
 from .tangents import fd_tangent
+from .history import History
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
            "MasterIncompressible",
            "IncompressibleP0",
-           "NodalPressure", "model_for", "fd_tangent"]
+           "NodalPressure", "model_for", "fd_tangent", "History"]
