@@ -33,6 +33,7 @@ import skfem as fem
 from skfem.helpers import ddot, grad
 
 from ..discretization.assembly import assemble
+from ..discretization.elementwise import Elements
 from ..threads import kernel
 from .history import History
 from .tangents import fd_tangent
@@ -157,7 +158,6 @@ class Hyperelastic:
         element's points: per family (particle) on a family basis, per
         cell on a scikit-fem basis — and its maximum over all points;
         ``None`` for a material without history."""
-        from ..discretization.elementwise import Elements
         h = self.history
         if h is None:
             return None

@@ -41,10 +41,6 @@ class History:
     def __repr__(self):
         return "History({!r})".format(self.material)
 
-    @property
-    def K(self):
-        return self.material.K
-
     def _check(self, F):
         shape = F.shape[2:]
         if self.committed is None:

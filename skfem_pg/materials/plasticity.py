@@ -60,6 +60,12 @@ RETURN_MAXITER = 50
 EIGEN_GAP = 1e-6
 
 
+def _von_mises(tau):
+    """:math:`\\sigma_{vM} = \\sqrt{3/2\\,\\tau:\\tau}` of deviatoric principal
+    stresses ``(n, 3)``."""
+    return np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
+
+
 class ReturnMapError(RuntimeError):
     """The local Newton of the return map did not converge; ``points`` are
     the flat indices of the integration points concerned."""
@@ -151,12 +157,10 @@ class J2Plasticity(Material):
     def initial_history(self, point_shape):
         """The virgin state at points of shape ``point_shape``:
         ``Cp_inv`` ``(3, 3, *point_shape)`` the identity, ``alpha`` zero."""
-        n = int(np.prod(point_shape))
-        Cp = np.zeros((3, 3, n))
-        for a in range(3):
-            Cp[a, a] = 1.0
-        return {"Cp_inv": Cp.reshape((3, 3) + tuple(point_shape)),
-                "alpha": np.zeros(tuple(point_shape))}
+        shape = tuple(point_shape)
+        Cp = np.broadcast_to(np.eye(3).reshape((3, 3) + (1,) * len(shape)),
+                             (3, 3) + shape).copy()
+        return {"Cp_inv": Cp, "alpha": np.zeros(shape)}
 
     # -- the stress update ---------------------------------------------
     def update(self, F, history):
@@ -193,8 +197,7 @@ class J2Plasticity(Material):
 
     def _local_residual(self, x, da, xtr, alpha_n):
         tau, T = self._tau(x)
-        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
-        s = np.maximum(s, 1e-300)
+        s = np.maximum(_von_mises(tau), 1e-300)
         nA = 1.5 * tau / s[:, None]
         ds = 1.5 * np.einsum("na,nab->nb", tau, T) / s[:, None]
         dn = 1.5 * (T / s[:, None, None]
@@ -220,8 +223,7 @@ class J2Plasticity(Material):
         estimate :math:`\phi/(3\bar\mu + H')` overshoots at large steps
         (neo-Hooke stiffens) and can flip the flow direction."""
         tau, _ = self._tau(xtr)
-        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
-        ntr = 1.5 * tau / s[:, None]
+        ntr = 1.5 * tau / _von_mises(tau)[:, None]
         xdev = xtr - xtr.mean(axis=1, keepdims=True)
         hi = np.sum(xdev * ntr, axis=1) / 3.0  # (x_dev . n) / (2 |n|^2)
         lo = np.zeros_like(hi)
@@ -229,7 +231,7 @@ class J2Plasticity(Material):
         for _ in range(iterations):
             x = xtr - 2 * da[:, None] * ntr
             t, T = self._tau(x)
-            sv = np.sqrt(1.5 * np.sum(t ** 2, axis=1))
+            sv = _von_mises(t)
             g = sv - self.yield_stress(alpha_n + da)
             lo = np.where(g > 0, da, lo)
             hi = np.where(g > 0, hi, da)
@@ -246,21 +248,23 @@ class J2Plasticity(Material):
     def return_map(self, xtr, alpha_n):
         """Principal log elastic stretches ``x`` ``(n, 3)`` and increments
         ``dalpha`` of the plastic points whose trial log stretches are
-        ``xtr`` ``(n, 3)``, and the local Jacobians ``(n, 4, 4)`` at the
-        solution (for the tangent)."""
+        ``xtr`` ``(n, 3)``, and at the solution the local Jacobians ``(n,
+        4, 4)`` and the principal stresses with their derivatives
+        (:meth:`_tau`), for the tangent."""
         n = xtr.shape[0]
         x, da = self._radial_start(xtr, alpha_n)
         todo = np.arange(n)
         Jl_all = np.empty((n, 4, 4))
+        tau_all, T_all = np.empty((n, 3)), np.empty((n, 3, 3))
         for it in range(RETURN_MAXITER):
-            R, Jl, _, _ = self._local_residual(x[todo], da[todo], xtr[todo],
-                                               alpha_n[todo])
-            err = np.abs(R).max(axis=1)
-            done = err <= RETURN_TOL
-            Jl_all[todo[done]] = Jl[done]
+            R, Jl, tau, T = self._local_residual(
+                x[todo], da[todo], xtr[todo], alpha_n[todo])
+            done = np.abs(R).max(axis=1) <= RETURN_TOL
+            i = todo[done]
+            Jl_all[i], tau_all[i], T_all[i] = Jl[done], tau[done], T[done]
             todo, R, Jl = todo[~done], R[~done], Jl[~done]
             if todo.size == 0:
-                return x, da, Jl_all
+                return x, da, Jl_all, tau_all, T_all
             step = np.linalg.solve(Jl, -R[..., None])[..., 0]
             # a step may not make dalpha negative (the yield surface
             # would be left on the wrong side)
@@ -301,20 +305,23 @@ class Response:
             raise ValueError("J2Plasticity needs F of shape (d, d, ...) with "
                              "d = 2 (plane strain) or 3, got {}".format(
                                  F.shape))
+        if not np.isfinite(m.K):
+            raise ValueError("{!r} is incompressible (K = inf): only the "
+                             "formulations with a pressure unknown (IUnlP0) "
+                             "carry it, through its isochoric part".format(m))
         self.point_shape = F.shape[2:]
         n = int(np.prod(self.point_shape))
+        if history["alpha"].size != n:
+            raise ValueError("a history of {} points for F at {}".format(
+                history["alpha"].size, n))
         Cp = history["Cp_inv"].reshape(3, 3, n)
         alpha_n = history["alpha"].reshape(n)
-        if Cp.shape[2] != n:
-            raise ValueError("history of {} points for F at {}".format(
-                Cp.shape[2], n))
         F3 = _embed3(F.reshape(d, d, n))
         # non-finite F (a failed local solve upstream): NaN stresses
         # there, so that the caller's step is cut
         bad = ~np.all(np.isfinite(F3), axis=(1, 2))
         if bad.any():
             F3[bad] = np.eye(3)
-        self._F3 = F3
         Cpn = np.moveaxis(Cp, 2, 0)
         self._G = F3 @ Cpn  # F C_p,n^-1
         btr = self._G @ np.swapaxes(F3, 1, 2)
@@ -327,18 +334,16 @@ class Response:
                 "(first {}): F inverted".format(neg.size, neg[0]), neg)
         xtr = np.log(beta)
         tau, T = m._tau(xtr)
-        s = np.sqrt(1.5 * np.sum(tau ** 2, axis=1))
-        plastic = s - m.yield_stress(alpha_n) > 0
+        plastic = _von_mises(tau) - m.yield_stress(alpha_n) > 0
         x = xtr.copy()
         dxdx = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
         alpha = alpha_n.copy()
         if np.any(plastic):
-            xp, da, Jl = m.return_map(xtr[plastic], alpha_n[plastic])
-            x[plastic] = xp
+            x[plastic], da, Jl, tau[plastic], T[plastic] = m.return_map(
+                xtr[plastic], alpha_n[plastic])
             alpha[plastic] += da
             # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
             dxdx[plastic] = np.linalg.inv(Jl)[:, :3, :3]
-            tau[plastic], T[plastic] = m._tau(xp)
         self.plastic = plastic.reshape(self.point_shape)
         Finv3, J = inverse_and_det(np.moveaxis(F3, 0, -1))
         self._Finv = np.moveaxis(Finv3, -1, 0)  # (n, 3, 3)
@@ -346,7 +351,6 @@ class Response:
         self._beta, self._Q, self._x = beta, Q, x
         self._tau_dev, self._dtdx = tau, T @ dxdx  # d tau_A / d xtr_B
         vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
-        self._vol = vol
         tau_full = np.einsum("nia,na,nma->nim", Q, tau, Q)
         P3 = (tau_full + vol[:, None, None] * np.eye(3)) @ \
             np.swapaxes(self._Finv, 1, 2)
