@@ -4,7 +4,9 @@ A free 20 x 10 particle block (2 x 1, E = 1, nu = 0.4, linear elasticity),
 lumped mass M = diag(V): the generalized spectrum K phi = lambda M phi of
 U1 (WTE1: classical correspondence, FE-connectivity families and a 3.01 h
 horizon), PBG Unl (MTE1) without and with VC, PBG Unl with a 3.01 h
-horizon, PPG Unl and FE Q1 on the same nodes.  Prints, per formulation,
+horizon, PPG Unl, the stabilized under-integrated U1SUnl and U1SIG (thesis
+6.3; the neo-Hooke tangent at rest, which is this linear elasticity) and FE
+Q1 on the same nodes.  Prints, per formulation,
 the number of zero eigenvalues (3 = rigid-body modes only), the number of
 soft modes below half of Q1's first deformation mode, and the first
 deformation eigenvalue; plots the lowest 40 eigenvalues and the first
@@ -21,7 +23,7 @@ import skfem_pg as pg
 from skfem_pg.scenes.reporting import demo_parser, output_dir
 from skfem_pg.scenes.reporting import save_figure
 from skfem_pg.materials import lame
-from skfem_pg.formulations import linear_elasticity
+from skfem_pg.formulations import U1SIG, U1SUnl, linear_elasticity
 from skfem_pg.analysis.spectrum import classify, free_modes
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -52,6 +54,12 @@ def main(nx=20, ny=10, distortion=0.0):
     for name, kw in formulations(p).items():
         b = pg.FamilyBasis(p, dim=2, **kw)
         spectra[name] = free_modes(pg.assemble(form, b), M, vectors=True)
+    unl = pg.FamilyBasis(p, dim=2)
+    material = pg.materials.NeoHookeIsoVol.from_lame(*lame(1.0, 0.4))
+    for name, cls in (("VC PBG U1SUnl", U1SUnl), ("VC PBG U1SIG", U1SIG)):
+        model = cls(unl, material)
+        K = model.tangent(model.state(model.initial()))
+        spectra[name] = free_modes(K, M, vectors=True)
     ref = spectra["FE Q1"]["eigenvalues"][3]
     print("free {} x {} block, nu = 0.4, K phi = lambda M phi; Q1's first "
           "deformation mode lambda_4 = {:.4e}".format(nx, ny, ref))

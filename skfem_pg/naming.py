@@ -20,7 +20,8 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
 ``U1``      WTE1 (classical correspondence), ``Unl`` MTE1, ``U2`` WTE2
 ``UnlP0``   mixed (thesis 6.2): ``UnlP0``, ``IUnlP0``, ``Unl+P1C`` on MTE1
             displacements, ``U2P1``, ``U2P1C`` on WTE2; stabilized (6.3):
-            ``U1SUnl``, ``U1SIG`` on WTE1
+            ``U1SUnl`` (WTE1 at the masters, stabilized on its MTE1
+            basis), ``U1SIG`` on WTE1 without bond correction
 ``TL``      total Lagrangian reference frame (the default; ``UL``, updated
             Lagrange, is not built yet)
 ==========  ==============================================================
@@ -45,7 +46,10 @@ import re
 SHAPES = {"U1": "WTE1", "Unl": "MTE1", "U2": "WTE2",
           "UnlP0": "MTE1", "IUnlP0": "MTE1", "Unl+P1C": "MTE1",
           "U2P1": "WTE2", "U2P1C": "WTE2",
-          "U1SUnl": "WTE1", "U1SIG": "WTE1"}
+          "U1SUnl": "MTE1", "U1SIG": "WTE1"}
+#: formulations whose displacement gradient lives at the master alone,
+#: where the bond correction has no bond: their basis is WTE1 without it
+MASTER_ONLY = ("U1SIG",)
 #: the displacement formulations (the rest are mixed or stabilized)
 DISPLACEMENT = ("U1", "Unl", "U2")
 #: first-order formulations: the bond correction is their default
@@ -108,10 +112,14 @@ def parse(name):
         raise ValueError("{!r}: the bond correction is for first-order "
                          "formulations ({}), not {}".format(
                              name, ", ".join(FIRST_ORDER), form))
+    if g["bc"] and form in MASTER_ONLY:
+        raise ValueError("{!r}: {} evaluates its gradient at the master "
+                         "only, where the bond correction has no bond; "
+                         "drop 'BC'".format(name, form))
     if g["bc"] and g["nobc"]:
         raise ValueError("{!r} asks for BC and noBC".format(name))
     kw = {"shape": SHAPES[form], "method": method,
-          "bond": first_order and not g["nobc"]}
+          "bond": first_order and not g["nobc"] and form not in MASTER_ONLY}
     notes = []
     if g["vc"] is None:
         if g["variant"] or g["boundary"]:

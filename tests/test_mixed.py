@@ -14,7 +14,8 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.formulations import (Hyperelastic, IncompressibleP0,
                                    MasterDilatation, MasterIncompressible,
-                                   MeanDilatation, NodalPressure)
+                                   MeanDilatation, NodalPressure, U1SIG,
+                                   U1SUnl)
 from skfem_pg.formulations.by_name import model_for
 from skfem_pg.scenes import Scene
 from skfem_pg.solvers import newton
@@ -246,9 +247,8 @@ def test_mixed_names_build_their_models():
         model_for("IUnlP0", b, m)
     with pytest.raises(ValueError, match="IUnlP0"):
         Hyperelastic(b, inc)
-    for planned in ("U1SUnl", "U1SIG"):
-        with pytest.raises(NotImplementedError, match=re.escape(planned)):
-            model_for(planned, b, m)
+    assert isinstance(model_for("U1SUnl", b, m), U1SUnl)
+    assert isinstance(model_for("U1SIG", b, m), U1SIG)
     ppg = pg.FamilyBasis.from_name(p, "VCPPG Unl", dim=2)
     assert isinstance(model_for("UnlP0", ppg, m), MasterDilatation)
     assert isinstance(model_for("IUnlP0", ppg, inc), MasterIncompressible)

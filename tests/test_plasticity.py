@@ -129,7 +129,8 @@ def test_single_point_uniaxial_against_closed_form():
 
 
 @pytest.mark.parametrize("name", ["H1", "H1P0", "PG", "VCPBG V5m UnlP0",
-                                  "VCPBG V5m Unl+P1C"])
+                                  "VCPBG V5m Unl+P1C", "VCPBG V5m U1SUnl",
+                                  "VCPBG V3m U1SIG"])
 def test_homogeneous_uniaxial_tension(name):
     """A unit cube on three symmetry planes pulled to stretch 1.3: the
     reaction force and the plastic strain equal the closed form."""
@@ -283,7 +284,8 @@ def plane_strain_uniaxial(m, loads, stretch):
     ("VCPBG V3m U2", False), ("VCPBG V3m U2P1", False),
     ("VCPBG V3m U2P1C", False), ("VCBCPPG V3m UnlP0", False),
     ("VCPBG V5m IUnlP0", True), ("VCBCPPG V3m IUnlP0", True),
-    ("FEM Q1P0", True)])
+    ("FEM Q1P0", True), ("VCPBG V5m U1SUnl", False),
+    ("VCPBG V3m U1SIG", False)])
 def test_every_mixed_formulation_carries_plasticity(name, incompressible):
     """Homogeneous plane-strain tension to stretch 1.2 (compressible and
     nu = 0.5): plastic strain and force equal the single-point law along

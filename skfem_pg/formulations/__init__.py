@@ -18,6 +18,9 @@ The model interface (fields, residual, tangent) is described in
                        Q1P0/H1P0
 ``nodal``              :class:`NodalPressure`: nodal p and Theta as global
                        unknowns — PBG U2P1C, Unl+P1C (a condensed bubble)
+``stabilized``         :class:`U1SUnl`, :class:`U1SIG`: under-integrated
+                       U1 (material and history at the masters) with
+                       full-integration or implicit-gradient stabilization
 ``by_name``            the model of a Table 7.1 formulation token
 ``history``            :class:`History`: a plastic material's internal
                        variables at a model's integration points,
@@ -31,6 +34,7 @@ from .dilatation import MeanDilatation
 from .incompressible import IncompressibleP0
 from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
+from .stabilized import U1SUnl, U1SIG
 from .by_name import model_for
 from .tangents import fd_tangent
 from .history import History
@@ -39,4 +43,5 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
            "MasterIncompressible",
            "IncompressibleP0",
-           "NodalPressure", "model_for", "fd_tangent", "History"]
+           "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
+           "History"]

@@ -19,10 +19,11 @@ token                   model
 ``U2P1C``               :class:`~.nodal.NodalPressure` (PBG, WTE2 basis)
 ``Unl+P1C``             :class:`~.nodal.NodalPressure` with the bubble
                         (PBG, MTE1 basis)
+``U1SUnl``              :class:`~.stabilized.U1SUnl` (PBG, MTE1 basis for
+                        the stabilization, WTE1 at the masters)
+``U1SIG``               :class:`~.stabilized.U1SIG` (PBG, WTE1 at the
+                        masters)
 ======================  ===================================================
-
-``U1SUnl``, ``U1SIG`` (6.3) parse (:mod:`skfem_pg.naming`) but are not
-built yet: they raise ``NotImplementedError``.
 """
 import numpy as np
 
@@ -31,11 +32,12 @@ from .displacement import Hyperelastic
 from .incompressible import IncompressibleP0
 from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
+from .stabilized import U1SIG, U1SUnl
 
 #: built formulation tokens beyond the displacement ones
 MIXED = {"UnlP0": MeanDilatation, "IUnlP0": IncompressibleP0}
-#: Table 7.1's formulations that parse but are not built yet
-PLANNED = ("U1SUnl", "U1SIG")
+#: the stabilized under-integrated formulations (6.3)
+STABILIZED = {"U1SUnl": U1SUnl, "U1SIG": U1SIG}
 
 
 def _incompressible(material):
@@ -45,11 +47,8 @@ def _incompressible(material):
 def model_for(formulation, basis, material, tangent="consistent"):
     """The model of ``formulation`` (a token of Table 7.1 or an FE
     method) on ``basis`` with ``material``."""
-    if formulation in PLANNED:
-        raise NotImplementedError(
-            "formulation {!r} (thesis 6.3) is not built yet; built: U1, "
-            "Unl, U2, UnlP0, IUnlP0, U2P1, U2P1C, Unl+P1C and the FE "
-            "comparators".format(formulation))
+    if formulation in STABILIZED:
+        return STABILIZED[formulation].of(basis, material)
     if formulation in ("Q1P0", "H1P0"):
         cls = IncompressibleP0 if _incompressible(material) \
             else MeanDilatation

@@ -203,3 +203,111 @@ def mls1_master_gradients(x, volumes, fam, n=1):
     with the evaluation point, :func:`master_fits`), master weight
     excluded.  Linearly consistent; a PPG test function option."""
     return master_fits(x, volumes, fam, n, 1, moving=True)[2]
+
+
+#: the master's own weight in the MLS1 Hessian of U1SIG (6.28): the
+#: "exception" of (5.42), :math:`\omega^{kk} = 1/(1000\,h)^{2n}` (``h`` the
+#: family radius) instead of an infinite one; constant near the master
+MASTER_WEIGHT_DISTANCE = 1000.0
+
+
+def mls1_hessian_at(D, V, n=1, fixed=None):
+    r"""Second derivatives of the MLS1 shape functions (moving weights,
+    linear basis) at the evaluation point ``x``, in the scaled offsets
+    ``D = (X^i - x)/h`` ``(nf, m, d)`` with volumes ``V`` ``(nf, m)``;
+    ``fixed`` ``(nf, m)`` (optional) weights that do not move with ``x``
+    (the master's exception).  Returns ``(H, singular)``, ``H``
+    ``(nf, m, d, d)`` in units of ``1/h^2``.
+
+    With :math:`N^i = W^i p^i\cdot a`, :math:`a = M^{-1}e_0`,
+    :math:`M = \sum_l W^l p^l\otimes p^l`, :math:`p^i = (1, D^i)`,
+    :math:`\partial_a p = -e_{1+a}`, :math:`W = V|D|^{-2n}`,
+    :math:`\partial_a W = 2nW D_a/|D|^2`,
+    :math:`\partial_{ab} W = \frac{2nW}{|D|^2}\big(2(n+1)\frac{D_aD_b}
+    {|D|^2} - \delta_{ab}\big)`:
+
+    .. math::
+
+        \partial_{ab}N = \partial_{ab}W\,p\cdot a
+        + \partial_a W(\partial_b p\cdot a + p\cdot\partial_b a)
+        + \partial_b W(\partial_a p\cdot a + p\cdot\partial_a a)
+        + W(\partial_a p\cdot\partial_b a + \partial_b p\cdot\partial_a a
+        + p\cdot\partial_{ab} a),
+
+    :math:`\partial_a a = -M^{-1}\partial_a M\,a`,
+    :math:`\partial_{ab} a = -M^{-1}(\partial_{ab}M\,a + \partial_a M\,
+    \partial_b a + \partial_b M\,\partial_a a)`.
+    """
+    nf, m, d = D.shape
+    q = d + 1
+    r2 = (D ** 2).sum(-1)
+    W = weights(r2, n) * V
+    moving = np.ones_like(W) if fixed is None else (fixed == 0)
+    W = np.where(moving, W, 0.0) + (0.0 if fixed is None else fixed)
+    safe = np.where(r2 > 0, r2, 1.0)
+    g = np.where((r2 > 0) & moving, 2.0 * n * W / safe, 0.0)  # (nf, m)
+    dW = g[..., None] * D
+    ddW = g[..., None, None] * (
+        2.0 * (n + 1) * D[..., :, None] * D[..., None, :]
+        / safe[..., None, None] - np.eye(d))
+    p = _basis(D, 1)
+    M = np.einsum("fl,flq,flr->fqr", W, p, p)
+    Minv, singular = inverse_spd(M)
+    a = Minv[..., :, 0]  # (nf, q)
+    dp = -np.eye(q)[1:]  # dp[b] = -e_{1+b}, (d, q)
+    s = np.einsum("fl,flq->fq", W, p)  # Σ W p
+    t = np.einsum("fla,flq->faq", dW, p)  # Σ ∂_a W p
+    sw = W.sum(axis=1)
+    dM = (np.einsum("fla,flq,flr->faqr", dW, p, p)
+          + np.einsum("bq,fr->fbqr", dp, s) + np.einsum("fq,br->fbqr", s,
+                                                        dp))
+    da = -np.einsum("fqr,fbrs,fs->fbq", Minv, dM, a)  # (nf, d, q)
+    ddM = np.einsum("flab,flq,flr->fabqr", ddW, p, p)
+    dpt = np.einsum("bq,far->fbaqr", dp, t)  # ∂_b p ⊗ t_a
+    ddM += dpt + np.swapaxes(dpt, -1, -2)
+    ddM += np.swapaxes(dpt, 1, 2) + np.swapaxes(np.swapaxes(dpt, 1, 2), -1,
+                                                -2)
+    pp = np.einsum("aq,br->abqr", dp, dp)
+    ddM += sw[:, None, None, None, None] * (pp + np.swapaxes(pp, 0, 1))
+    rhs = (np.einsum("fabqr,fr->fabq", ddM, a)
+           + np.einsum("faqr,fbr->fabq", dM, da)
+           + np.einsum("fbqr,far->fabq", dM, da))
+    dda = -np.einsum("fqr,fabr->fabq", Minv, rhs)
+    pa = np.einsum("flq,fq->fl", p, a)
+    pda = np.einsum("flq,fbq->flb", p, da)  # p·∂_b a
+    dpa = np.einsum("bq,fq->fb", dp, a)  # ∂_b p·a (same for every l)
+    dpda = np.einsum("aq,fbq->fab", dp, da)  # ∂_a p·∂_b a
+    H = ddW * pa[..., None, None]
+    X = dW[..., :, None] * (dpa[:, None, None, :] + pda[..., None, :])
+    H += X + np.swapaxes(X, -1, -2)
+    H += W[..., None, None] * ((dpda + np.swapaxes(dpda, 1, 2))[:, None]
+                               + np.einsum("flq,fabq->flab", p, dda))
+    return H, singular
+
+
+def mls1_master_hessians(x, volumes, fam, n=1):
+    r"""Second derivatives of the MLS1 shape functions at the masters,
+    ``(nf, m, d, d)`` (zero in padded slots): :math:`\partial^2
+    N^{kki}_{MLS1}/\partial X^2` of U1SIG (6.28), moving weights, the
+    master's weight the constant exception
+    :math:`1/(1000\,h_k)^{2n}` (:data:`MASTER_WEIGHT_DISTANCE`).  They
+    annihilate constant and linear fields to round-off,
+    :math:`\sum_i \partial^2 N^{kki} = 0`, :math:`\sum_i X^i\otimes
+    \partial^2 N^{kki} = 0`."""
+    mem_all, mask_all = fam.padded()
+    nf, m = mem_all.shape
+    d = x.shape[0]
+    H = np.zeros((nf, m, d, d))
+    for sl in chunks(nf, m * (d + 1) ** 2 * d * d):
+        geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
+        fixed = np.zeros(geo.V.shape)
+        fixed[:, 0] = geo.V[:, 0] * MASTER_WEIGHT_DISTANCE ** (-2.0 * n)
+        Hs, singular = mls1_hessian_at(geo.D0, geo.V, n, fixed)
+        if np.any(singular):
+            k = np.nonzero(singular)[0][0]
+            raise_singular(x, fam.masters[sl], fam.sizes[sl], geo.mem, k,
+                           None, "MLS1 (needs {} members besides the master "
+                           "in general position)".format(d + 1))
+        H[sl] = Hs * geo.mask[..., None, None] \
+            / (geo.h ** 2)[:, None, None, None]
+    return H
