@@ -1,11 +1,14 @@
 """Cost of the J2 return map: one plastic Newton iteration against the
-hyperelastic one on the same basis (PG VC PBG Unl and FE H1P0, 3-D cube).
+hyperelastic one on the same basis (PG VC PBG Unl, U1SUnl, U1SIG and FE
+H1P0, 3-D cube).
 
 A unit cube of n^3 hexahedra (default n = 10: 1331 nodes), stretched 5 %
 (every point plastic for the steel of thesis 7.3.5); per formulation and
 material: seconds of the state (F), the internal force (with the stress
 update), the tangent (material tangent + assembly) and the linear solve,
-and the return map's cost per integration point.  The batched kernels run
+and the return map's cost per integration point (U1SUnl / U1SIG: one per
+family, at the master; ``vs Unl``: the total against PG Unl's hyperelastic
+iteration).  The batched kernels run
 with the package's default of one BLAS thread (``skfem_pg.threads``).
 
     python benchmarks/plasticity_cost.py [--n 10]
@@ -51,7 +54,8 @@ def iteration(model, basis, D):
     t_solve = time.perf_counter() - t0
     h = getattr(model, "history", None)
     npts = None if h is None else h.committed["alpha"].size
-    plastic = None if h is None else float(h.response(s["F"]).plastic.mean())
+    F = s["F1"] if "F1" in s else s["F"]  # U1S*: the masters' F
+    plastic = None if h is None else float(h.response(F).plastic.mean())
     return dict(state=t_state, force=t_force, tangent=t_tan, solve=t_solve,
                 points=npts, plastic=plastic)
 
@@ -66,11 +70,15 @@ def main():
     elastic = STEEL.elastic()
     print("cube {0}x{0}x{0}, {1} nodes; seconds (best of 3)".format(
         n, mesh.nvertices))
-    print("{:8s} {:10s} {:>7s} {:>7s} {:>7s} {:>7s} {:>7s} {:>8s} {:>6s}"
-          .format("basis", "material", "state", "force", "tangent", "solve",
-                  "total", "us/point", "ratio"))
+    print("{:8s} {:10s} {:>7s} {:>7s} {:>7s} {:>7s} {:>7s} {:>8s} {:>6s} "
+          "{:>6s}".format("basis", "material", "state", "force", "tangent",
+                          "solve", "total", "us/point", "ratio", "vs Unl"))
+    unl = None
+    pgb = pg.FamilyBasis(mesh, dim=3)
     for label, make, token in [
-            ("PG Unl", lambda: pg.FamilyBasis(mesh, dim=3), "Unl"),
+            ("PG Unl", lambda: pgb, "Unl"),
+            ("U1SUnl", lambda: pgb, "U1SUnl"),
+            ("U1SIG", lambda: pgb, "U1SIG"),
             ("H1P0", lambda: fem.Basis(mesh, fem.ElementVector(
                 fem.ElementHex1()), intorder=2), "H1P0")]:
         basis = make()
@@ -81,14 +89,15 @@ def main():
             rows[name] = iteration(model, basis, D)
         base = sum(v for k, v in rows["neo-Hooke"].items()
                    if k in ("state", "force", "tangent", "solve"))
+        unl = base if unl is None else unl
         for name, r in rows.items():
             tot = r["state"] + r["force"] + r["tangent"] + r["solve"]
             extra = (tot - base) / r["points"] * 1e6 if r["points"] else 0.0
             print("{:8s} {:10s} {:7.3f} {:7.3f} {:7.3f} {:7.3f} {:7.3f} "
-                  "{:>8s} {:6.2f}".format(
+                  "{:>8s} {:6.2f} {:6.2f}".format(
                       label, name, r["state"], r["force"], r["tangent"],
                       r["solve"], tot, "{:.2f}".format(extra)
-                      if r["points"] else "-", tot / base))
+                      if r["points"] else "-", tot / base, tot / unl))
         print("  {} points, {:.0%} plastic".format(rows["J2"]["points"],
                                                    rows["J2"]["plastic"]))
 

@@ -120,14 +120,16 @@ THESIS_NAMES = [
 def test_every_thesis_name_parses(name):
     """The displacement basis of each formulation, with Table 7.1's
     defaults: BC for the first-order ones (U1, Unl and the mixed and
-    stabilized formulations built on them), none for U2-based ones."""
+    stabilized formulations built on them), none for U2-based ones nor for
+    U1SIG (its gradient lives at the master, where there is no bond;
+    U1SUnl's basis is the MTE1 one its stabilization integrates)."""
     kw, _ = parse(name)
     form = formulation_of(name)
     assert name.split()[-1 if not name.endswith("TL") else -2] == form
-    shape = {"U1": "WTE1", "U1SUnl": "WTE1", "U1SIG": "WTE1",
+    shape = {"U1": "WTE1", "U1SIG": "WTE1",
              "U2": "WTE2", "U2P1": "WTE2", "U2P1C": "WTE2"}.get(form, "MTE1")
     assert kw["shape"] == shape
-    assert kw["bond"] == (shape != "WTE2")
+    assert kw["bond"] == (shape != "WTE2" and form != "U1SIG")
     assert kw["method"] == ("PBG" if "PBG" in name else "PPG1")
     if name.startswith("VC"):
         assert kw["vc_boundary"] in ("sn", "s", "p")

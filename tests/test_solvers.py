@@ -231,3 +231,36 @@ def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
     attempts = [(s, t) for s, t, _ in tried]
     assert all(a != b for a, b in zip(attempts, attempts[1:]))
     assert tried[-1][1:] == (1.0, True)
+
+
+def test_amg_on_sliding_boundaries_and_the_step_callback():
+    """Symmetry planes leave free dofs that are not whole nodes: the AMG's
+    rigid-body modes take each dof's component (they broke pyamg's shape
+    check before); the callback sees every converged step with its
+    internal force (the reactions)."""
+    from skfem_pg.scenes import Scene
+    from skfem_pg.solvers import rigid_body_modes
+    mesh = fem.MeshHex.init_tensor(*[np.linspace(0, 1, 5)] * 3)
+    sc = Scene("sym", mesh.with_defaults(), mat.NeoHookeIsoVol(1.0, 3.0),
+               prescribed={"left": {0: 0.0}, "bottom": {1: 0.0},
+                           "front": {2: 0.0}, "right": {0: 0.1}})
+    basis, model, f, D, u_D, _ = sc.setup("H1")
+    seen = []
+    x1, hist = newton(model, f, D=D, u_D=u_D, solver="amg", steps=2,
+                      adaptive=False, verbose=False,
+                      callback=lambda x, t, f_int: seen.append(
+                          (t, x.copy(), f_int)))
+    x2, _ = newton(model, f, D=D, u_D=u_D, solver="direct", verbose=False)
+    assert np.abs(x1 - x2).max() < 1e-9 * np.abs(x2).max()
+    assert [t for t, _, _ in seen] == [0.5, 1.0]
+    assert np.array_equal(seen[-1][1], x1)
+    f_end = model.internal_force(model.state(x1))
+    assert np.abs(seen[-1][2] - f_end).max() < 1e-12 * np.abs(f_end).max()
+    # the modes of a subset equal the restriction of the whole nodes'
+    locs = basis.doflocs
+    free = np.setdiff1d(np.arange(basis.N), D)
+    B = rigid_body_modes(locs)
+    assert np.array_equal(rigid_body_modes(locs[:, free], free % 3),
+                          B[free])
+    with pytest.raises(ValueError, match="components"):
+        rigid_body_modes(locs[:, free[:-1]])

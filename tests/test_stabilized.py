@@ -229,3 +229,51 @@ def test_names_and_refusals():
     ppg = pg.FamilyBasis.from_name(p, "VCPPG Unl", dim=2)
     with pytest.raises(ValueError, match="PBG"):
         U1SIG(ppg, NeoHookeIsoVol(1.0, 3.0))
+
+
+def test_necking_bar_mesh():
+    """The eighth and the whole bar: positive volumes, eight eighths make
+    the whole, the centre radius 0.99 R, and the faceted volume just below
+    the tapered cylinder's."""
+    eighth = pg.meshing.necking_bar(1)
+    whole = pg.meshing.necking_bar(1, full=True)
+    vol = [fem.Basis(m, fem.ElementHex1()).dx.sum(axis=1)
+           for m in (eighth, whole)]
+    assert vol[0].min() > 0 and vol[1].min() > 0
+    assert np.isclose(8 * vol[0].sum(), vol[1].sum(), rtol=1e-9)
+    L, R = 53.334, 6.413
+    exact = np.pi * R ** 2 * L * (0.99 ** 2 + 0.99 + 1) / 3  # mean rho^2
+    assert 0.95 < vol[1].sum() / exact < 1.0
+    p = eighth.p
+    r = np.hypot(p[1], p[2])
+    assert np.isclose(r[np.isclose(p[0], 0)].max(), 0.99 * R)
+    assert np.isclose(r[np.isclose(p[0], L / 2)].max(), R)
+    assert set(eighth.boundaries) == {"center", "end", "ysym", "zsym"}
+    assert set(whole.boundaries) == {"left", "right"}
+
+
+def test_ppg_unlp0_refused_where_unstable():
+    """PPG UnlP0 in 3-D with the min-norm (or p) VC: its tangent at rest
+    has eigenvalues with negative real part (here measured again), so
+    the model refuses it; with 'sn' it is stable."""
+    import skfem_pg.formulations.master_dilatation as md
+    from skfem_pg.scenes import Scene
+    mesh = cube(4).with_boundaries({"a": lambda x: x[0] < 1e-9,
+                                    "b": lambda x: x[0] > 1 - 1e-9})
+    sc = Scene("x", mesh, NeoHookeIsoVol(1.0, 2.0), clamped=["a", "b"])
+    with pytest.raises(ValueError, match="unstable"):
+        sc.setup("VCBCPPG V3m UnlP0")
+    for name, unstable in (("VCBCPPG V3m UnlP0", True),
+                           ("VCBCPPG V3sn UnlP0", False)):
+        if unstable:  # build it as it was before the check
+            saved, md.UNSTABLE_3D = md.UNSTABLE_3D, ()
+            try:
+                _, model, _, D, _, _ = sc.setup(name)
+            finally:
+                md.UNSTABLE_3D = saved
+        else:
+            _, model, _, D, _, _ = sc.setup(name)
+        K = model.tangent(model.state(model.initial()))
+        free = np.setdiff1d(np.arange(model.N), D)
+        ev = np.linalg.eigvals(K[free][:, free].toarray()).real
+        assert (ev < -1e-9 * np.abs(ev).max()).any() == unstable

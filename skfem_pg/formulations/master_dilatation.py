@@ -41,6 +41,10 @@ from .dilatation import _d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, material_tangent
 
 
+#: VC boundary variants with which PPG UnlP0 is unstable in 3-D
+UNSTABLE_3D = ("min-norm", "p")
+
+
 class MasterDilatation(Hyperelastic):
     """PPG UnlP0 on a Petrov–Galerkin :class:`~skfem_pg.FamilyBasis`
     (``method="PPG1"``) whose families are mastered by every particle;
@@ -55,6 +59,17 @@ class MasterDilatation(Hyperelastic):
                 "the master-point dilatation is PPG UnlP0 on a PPG1 basis "
                 "(got {}); PBG UnlP0 is MeanDilatation".format(
                     getattr(basis, "method", type(basis).__name__)))
+        if basis.particles.dim == 3 and basis.vc is not None and \
+                basis.vc_boundary in UNSTABLE_3D and \
+                type(self) is MasterDilatation:
+            raise ValueError(
+                "PPG UnlP0 in 3-D with the VC boundary variant {!r} is "
+                "unstable: its constrained tangent at rest has eigenvalues "
+                "with negative real part (measured: 4 on a clamped 4x4x4 "
+                "hexahedral cube with 'm', 8 with 'm' and 51 with 'p' on "
+                "the necking bar; none with 's' / 'sn', none in 2-D); use "
+                "'VCPPG V3sn UnlP0' (no sliding boundaries) or PBG UnlP0"
+                .format(basis.vc_boundary))
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
         p, fam = basis.particles, basis.families

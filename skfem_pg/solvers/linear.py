@@ -10,11 +10,27 @@ import numpy as np
 import scipy.sparse.linalg as spl
 
 
-def rigid_body_modes(doflocs):
-    """Rigid-body modes of a vector field with interleaved dofs at
-    ``doflocs`` (``(d, N)``): ``d`` translations and ``d(d-1)/2``
-    rotations, as columns."""
+def rigid_body_modes(doflocs, components=None):
+    """Rigid-body modes of a vector field with dofs at ``doflocs``
+    (``(d, N)``): ``d`` translations and ``d(d-1)/2`` rotations, as
+    columns.  ``components`` ``(N,)``: each dof's component — needed when
+    the dofs are a subset (free dofs with sliding boundaries: not whole
+    nodes); default: interleaved whole nodes (``j % d``)."""
     d, N = doflocs.shape
+    if components is not None:
+        c = np.asarray(components)
+        if c.shape != (N,):
+            raise ValueError("components: one per dof ({}), got {}".format(
+                N, c.shape))
+        modes = [(c == a).astype(float) for a in range(d)]
+        for a in range(d):
+            for b in range(a + 1, d):
+                modes.append(np.where(c == a, -doflocs[b], 0.0)
+                             + np.where(c == b, doflocs[a], 0.0))
+        return np.column_stack(modes)
+    if N % d:
+        raise ValueError("{} dofs are not whole nodes of {} components: "
+                         "pass components=".format(N, d))
     x = doflocs[:, ::d]
     n = x.shape[1]
     modes = []
@@ -180,8 +196,9 @@ class AMGSolver:
     def __init__(self, doflocs=None, tol=1e-10, symmetric=True,
                  smooth="energy", maxiter=500,
                  direct_limit=4 * DIRECT_LIMIT[3], ordering="auto",
-                 candidates=0, graph=None):
+                 candidates=0, graph=None, components=None):
         self.doflocs, self.tol, self.symmetric = doflocs, tol, symmetric
+        self.components = components
         self.candidates, self.graph = int(candidates), graph
         self.smooth, self.maxiter = smooth, maxiter
         self.direct_limit, self.ordering = direct_limit, ordering
@@ -194,7 +211,8 @@ class AMGSolver:
         import pyamg
         t0 = time.perf_counter()
         locs = self.doflocs
-        B = rigid_body_modes(locs) if locs is not None else None
+        B = rigid_body_modes(locs, self.components) if locs is not None \
+            else None
         bs = _node_blocks(locs) if locs is not None else 1
         M = A.tobsr(blocksize=(bs, bs)) if bs > 1 else A
         kw = {}
@@ -300,7 +318,7 @@ class AMGSolver:
 
 
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
-                  symmetric=True, candidates=0):
+                  symmetric=True, candidates=0, components=None):
     """A solver ``(A, b) -> x`` for ``fem.solve`` and Newton's method.
 
     ``"direct"``: :func:`direct` (PARDISO if installed, else SuperLU with
@@ -311,6 +329,9 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     for family bases in Newton's method);
     ``"auto"``: direct up to ``direct_limit`` unknowns (default
     :data:`DIRECT_LIMIT` of the dimension of ``doflocs``), else AMG.
+    ``components``: each condensed dof's component (for the rigid-body
+    modes when the free dofs are not whole nodes, e.g. with symmetry
+    planes); Newton's method passes them.
     """
     dim = 2 if doflocs is None else doflocs.shape[0]
     ordering = ("pardiso" if pardiso_available()
@@ -322,7 +343,7 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                          "or 'amg'".format(kind))
     amg = AMGSolver(doflocs, tol=tol, symmetric=symmetric,
                     direct_limit=4 * direct_limit, ordering=ordering,
-                    candidates=candidates)
+                    candidates=candidates, components=components)
 
     def solve(A, b, **kwargs):
         k = kind

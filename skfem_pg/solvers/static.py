@@ -51,15 +51,20 @@ def _condensed_solver(kind, basis, I, extra_fields=False):
                              "solver='direct' (or 'auto')")
         return linear_solver("direct", None)
     locs = getattr(basis, "doflocs", None)
+    # scikit-fem's vector dofs (and the family bases') are interleaved:
+    # dof j is component j % d of its node, also for a subset of them
     return linear_solver(kind, None if locs is None else locs[:, I],
                          symmetric=getattr(basis, "test", None) is None,
                          candidates=PG_CANDIDATES if hasattr(basis, "layout")
-                         else 0)
+                         else 0,
+                         components=None if locs is None
+                         else I % locs.shape[0])
 
 
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           adaptive=True, predictor=True, verbose=True, load0=0.0):
+           adaptive=True, predictor=True, verbose=True, load0=0.0,
+           callback=None):
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
@@ -114,6 +119,11 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         Start each load step from the linear extrapolation of the last two
         converged states (secant predictor) instead of the last one; a
         step that fails from it is cut like any other.
+    callback
+        ``callback(x, load, f_int)`` after each converged (and committed)
+        step: its unknowns, load factor and internal force vector (the
+        reactions at the Dirichlet dofs) — output of load–displacement
+        curves and time series without a second evaluation.
 
     Returns
     -------
@@ -175,12 +185,15 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
                       " ".join("{:.1e}".format(r)
                                for r in info["residuals"]),
                       info["min_J"]), flush=True)
+        f_int = info.pop("f_int", None)
         if ok:
             if hasattr(model, "commit"):  # history of a converged step
                 model.commit(state)
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
+            if callback is not None:
+                callback(u, lam, f_int)
             if adaptive and len(info["residuals"]) <= 5:
                 dlam = min(2 * dlam, 1.0)
             continue
@@ -257,7 +270,8 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter):
         if not info["min_J"] > 0:
             info["reason"] = "J <= 0"
             return False, u, info, None
-        r = model.internal_force(state) - lam * f_ext
+        info["f_int"] = model.internal_force(state)
+        r = info["f_int"] - lam * f_ext
         info["t_assemble"] += time.perf_counter() - t0
         rn = float(np.linalg.norm(r[I]))
         res.append(rn)
