@@ -52,6 +52,7 @@ STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,
                                 delta=16.93)
 BAR = pg.meshing.NECKING_BAR
 ELONGATION = 5.0  # mm, of the whole bar
+SCALE = 0.1  # of Simo's bar: see the module docstring
 #: Fig. 7.24 name -> (the name solved here, the thesis' max e_p)
 METHODS = {
     "VCPBG Unl": ("VCPBG V5m Unl", 1.95),
@@ -67,11 +68,12 @@ METHODS = {
 }
 
 
-def scene(n, elongation=ELONGATION, full=False):
+def scene(n, elongation=ELONGATION, full=False, scale=SCALE):
     """One eighth (symmetry planes) or, ``full``, the whole bar clamped at
-    both ends; ``sc.end``: the moving end, ``sc.quarters``: the force's
-    multiplier."""
-    mesh = pg.meshing.necking_bar(n, full=full)
+    both ends, its length and radius ``scale`` times Simo's; ``sc.end``:
+    the moving end, ``sc.quarters``: the force's multiplier."""
+    mesh = pg.meshing.necking_bar(n, length=scale * BAR["length"],
+                                  radius=scale * BAR["radius"], full=full)
     if full:
         sc = Scene("necking", mesh, STEEL, clamped=["left"], prescribed={
             "right": {0: elongation, 1: 0.0, 2: 0.0}})
@@ -81,7 +83,7 @@ def scene(n, elongation=ELONGATION, full=False):
             "center": {0: 0.0}, "ysym": {1: 0.0}, "zsym": {2: 0.0},
             "end": {0: 0.5 * elongation, 1: 0.0, 2: 0.0}})
         sc.end, sc.quarters = "end", 4.0
-    sc.elongation, sc.full = elongation, full
+    sc.elongation, sc.full, sc.scale = elongation, full, scale
     return sc
 
 

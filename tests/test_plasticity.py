@@ -304,3 +304,23 @@ def test_every_mixed_formulation_carries_plasticity(name, incompressible):
     assert alpha > 0.1
     assert np.abs(ep - alpha).max() < 1e-8
     assert abs(r.reaction("right")[0] - P11) < 1e-7 * P11
+
+
+def test_bubble_recovers_from_a_bad_warm_start():
+    """Unl+P1C condenses its bubble by a local Newton started from the
+    last bubble: a start that breaks the return map or leads to a root
+    with J <= 0 (the last iterate of a failed step) is passed over for
+    the committed bubble and for zero, and the state equals the one from
+    a good start."""
+    mesh = cube(2).with_defaults()
+    sc = Scene("shear", mesh, STEEL, clamped=["left"], steps=2,
+               prescribed={"right": {0: 0.1, 1: 0.05, 2: 0.0}})
+    r = sc.solve("VCPBG V5m Unl+P1C")
+    model, x = r.model, r.x
+    good = model.state(x)
+    assert np.abs(good["ub"]).max() > 1e-4  # an inhomogeneous bubble
+    assert r.model.plastic_strain()[1] > 0.01
+    for bad in (1e3, -3.0):
+        model._ub = np.full_like(good["ub"], bad)
+        s = model.state(x)
+        assert np.abs(s["F"] - good["F"]).max() < 1e-10

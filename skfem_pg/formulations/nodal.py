@@ -34,7 +34,8 @@ Unknowns ``x = [u, p, Θ]``: displacements in scikit-fem numbering, then
 one p and one Θ per particle.  The bubble is condensed (6.6) exactly: for
 given ``x`` a batched local Newton over all families solves
 :math:`R_b^k = \sum_j w_{kj} P^{kj}\,(X^j - X_c^k) = 0` (``d × d`` systems,
-to :math:`|\Delta u_b|\,|X^j - X_c^k| \le 10^{-13}`), so the residual is a
+to :math:`|\Delta u_b|\,|X^j - X_c^k| \le 10^{-13}`; a step is capped
+at 0.2 of strain), so the residual is a
 function of ``x`` alone and its derivative, by the implicit function
 theorem, the condensed tangent :math:`K_{aa} - K_{ab}K_{bb}^{-1}K_{ba}`.
 
@@ -47,14 +48,18 @@ import scipy.sparse as sp
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
-from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..materials import NeoHookeIsoVol, ReturnMapError, inverse_and_det
 from ..threads import kernel
 from .dilatation import _d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 #: local Newton of the bubble: largest iterations, and the tolerance on
 #: the change of F
-BUBBLE_MAXITER, BUBBLE_TOL = 25, 1e-13
+BUBBLE_MAXITER, BUBBLE_TOL = 40, 1e-13
+#: the largest change of the bubble's strain in one local iteration
+BUBBLE_STEP = 0.2
+#: halvings of a family's bubble step before it is taken anyway
+BUBBLE_HALVINGS = 10
 
 
 class _Group:
@@ -111,6 +116,7 @@ class NodalPressure(Hyperelastic):
         for gr in self.groups:
             self._b[:, 0, gr.flat] = np.moveaxis(gr.b, -1, 0)
         self._ub = np.zeros((d, L.n_families))  # warm start of the bubble
+        self._ub_committed = self._ub  # of the last converged step
         self._pattern = None  # of the p, Theta and bubble blocks
 
     @classmethod
@@ -188,34 +194,83 @@ class NodalPressure(Hyperelastic):
         batched Newton from the last ones (and, should that fail — e.g.
         the last ones belong to another run —, from zero); also
         :math:`K_{bb}`."""
-        for start in (self._ub, np.zeros_like(self._ub)):
-            out = self._bubble_newton(Fu, p, start.copy())
-            if out is not None:
+        error = None
+        for start in (self._ub, self._ub_committed,
+                      np.zeros_like(self._ub)):
+            try:
+                out = self._bubble_newton(Fu, p, start.copy())
+            except ReturnMapError as err:  # a plastic material's local
+                error = err  # Newton at an iterate: try the next start
+                continue
+            # a root with J <= 0 (from the last iterate of a step that
+            # failed) is no bubble: try the next start
+            if out is not None and inverse_and_det(out[0])[1].min() > 0:
                 self._ub = out[1]
                 return out
+        if error is not None:  # Newton cuts the step, naming the reason
+            raise error
         # no convergence (e.g. J <= 0 inside a family): let Newton cut
         return np.full_like(Fu, np.nan), self._ub, None
 
     def _bubble_newton(self, Fu, p, ub):
+        """Newton on :math:`R_b^k(u_b^k) = 0`, every family at once (a
+        family's bubble moves only its own points, so the families are
+        independent): a step is capped at :data:`BUBBLE_STEP` of strain
+        and halved, family by family, until that family's residual
+        decreases (a plastic material's elastic–plastic switch made the
+        full steps cycle between two states).  ``None`` if it does not
+        converge."""
         E, b = self.elements, self._b
         bn = np.abs(b).max()
-        for it in range(BUBBLE_MAXITER):
+
+        def residual(ub):
             F = Fu + E.spread(ub)[:, None] * b[None]
             Finv, J, P = self._volumetric(F, p)
-            A = self._tangent_field(F, Finv, J, p)
             Rb = E.sum(np.einsum("iJ...,J...->i...", P, b))  # (d, nf)
+            return F, Finv, J, Rb
+
+        F, Finv, J, Rb = residual(ub)
+        for it in range(BUBBLE_MAXITER):
+            A = self._tangent_field(F, Finv, J, p)
             Kbb = E.sum(np.einsum("iJkL...,J...,L...->ik...", A, b, b))
             Kbb = np.moveaxis(Kbb, -1, 0)  # (nf, d, d)
             try:
                 dub = -np.linalg.solve(Kbb, Rb.T[..., None])[..., 0].T
             except np.linalg.LinAlgError:  # a family's K_bb is singular
                 return None
-            ub = ub + dub
-            if not np.all(np.isfinite(ub)):
+            if not np.all(np.isfinite(dub)):
                 return None
-            if np.abs(dub).max() * bn <= BUBBLE_TOL:
+            step = np.abs(dub).max(axis=0) * bn  # the bubble's strain
+            if step.max() <= BUBBLE_TOL:
+                ub = ub + dub
                 return Fu + E.spread(ub)[:, None] * b[None], ub, Kbb
+            t = np.minimum(1.0, BUBBLE_STEP / np.maximum(step, 1e-300))
+            r0 = np.linalg.norm(Rb, axis=0)
+            for _ in range(BUBBLE_HALVINGS):
+                try:
+                    trial = residual(ub + dub * t)
+                    worse = np.linalg.norm(trial[3], axis=0) > r0 * (
+                        1 - 1e-4 * t)
+                    worse &= step * t > BUBBLE_TOL  # round-off: accept
+                except ReturnMapError as err:  # too wild: all shorter
+                    trial, error = None, err
+                    worse = np.ones_like(t, dtype=bool)
+                if not worse.any():
+                    break
+                t[worse] *= 0.5
+            else:
+                if trial is None:
+                    raise error
+            ub = ub + dub * t
+            F, Finv, J, Rb = trial
         return None
+
+    def commit(self, state):
+        """A step converged: its bubble is the next steps' second warm
+        start (after the last iterate's); the history as for any model."""
+        super().commit(state)
+        if self.bubble and state.get("Kbb") is not None:
+            self._ub_committed = state["ub"].copy()
 
     def min_J(self, state):
         if not np.all(np.isfinite(state["F"])):
