@@ -324,3 +324,28 @@ def test_bubble_recovers_from_a_bad_warm_start():
         model._ub = np.full_like(good["ub"], bad)
         s = model.state(x)
         assert np.abs(s["F"] - good["F"]).max() < 1e-10
+
+
+@pytest.mark.parametrize("name", ["FEM H1P0", "VCPBG V3m U1SIG"])
+def test_necking_bar_peak_force_is_considere(name):
+    """The necking bar of demos/necking.py (Simo's scaled by 0.1, one
+    eighth, n = 1) pulled to 1.2 mm: the force peaks (then falls: a neck)
+    at the load of Considere's condition on the reduced centre section,
+    max over e of sigma_y(e) exp(-e) A_c with A_c the faceted section
+    (16 chords of radius 0.99 R); the elastic strains are below 0.5 %."""
+    L, R = 5.3334, 0.6413
+    mesh = pg.meshing.necking_bar(1, length=L, radius=R)
+    sc = Scene("neck", mesh, STEEL, prescribed={
+        "center": {0: 0.0}, "ysym": {1: 0.0}, "zsym": {2: 0.0},
+        "end": {0: 0.6, 1: 0.0, 2: 0.0}})
+    basis, model, f, D, u_D, _ = sc.setup(name)
+    end = np.unique(basis.get_dofs("end").all("u^1"))
+    force = []
+    newton(model, f, D=D, u_D=u_D, steps=10, verbose=False, solver="direct",
+           callback=lambda x, t, f_int: force.append(4 * f_int[end].sum()))
+    e = np.linspace(0.0, 1.0, 100001)
+    N = 16
+    A_c = 0.5 * N * (0.99 * R) ** 2 * np.sin(2 * np.pi / N)
+    F_considere = A_c * (STEEL.yield_stress(e) * np.exp(-e)).max()
+    assert abs(max(force) / F_considere - 1) < 0.01
+    assert force[-1] < 0.95 * max(force)  # past the peak: necking

@@ -67,8 +67,10 @@ class MasterDilatation(Hyperelastic):
                 "unstable: its constrained tangent at rest has eigenvalues "
                 "with negative real part (measured: 4 on a clamped 4x4x4 "
                 "hexahedral cube with 'm', 8 with 'm' and 51 with 'p' on "
-                "the necking bar; none with 's' / 'sn', none in 2-D); use "
-                "'VCPPG V3sn UnlP0' (no sliding boundaries) or PBG UnlP0"
+                "the necking bar; none with 's' / 'sn' on a clamped cube, "
+                "none in 2-D); use PBG UnlP0 ('VCPPG V3sn UnlP0' without "
+                "sliding boundaries is stable at rest but diverged on the "
+                "whole necking bar)"
                 .format(basis.vc_boundary))
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
