@@ -49,6 +49,7 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
+from skfem_pg.scenes.io import VTUSeries
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
                                        output_dir, save_figure,
                                        update_results)
@@ -103,33 +104,21 @@ def solved_name(label, full):
     return METHODS.get(label, (label,))[0], False
 
 
-class Series:
-    """A VTU per converged step and the .pvd collection that lists them."""
+def write_step(basis, u, ep):
+    """``write(filename)`` of one step for :class:`~skfem_pg.scenes.io.
+    VTUSeries`: the particles with u and e_p, or the FE mesh with u and
+    e_p per cell."""
+    if hasattr(basis, "particles"):
+        return lambda fn: pg.write_vtu(fn, basis.particles, u=u, ep=ep)
 
-    def __init__(self, folder):
-        self.folder, self.entries = folder, []
-        os.makedirs(folder, exist_ok=True)
-
-    def write(self, basis, u, ep, t):
-        fn = os.path.join(self.folder, "step_{:03d}.vtu".format(
-            len(self.entries)))
-        if hasattr(basis, "particles"):
-            pg.write_vtu(fn, basis.particles, u=u, ep=ep)
-        else:
-            import meshio
-            from skfem.io.meshio import to_meshio
-            m = to_meshio(basis.mesh, encode_cell_data=False)
-            m.point_data = {"u": u.reshape(-1, 3)}
-            m.cell_data = {"ep": [np.asarray(ep)]}
-            meshio.write(fn, m)
-        self.entries.append((t, os.path.basename(fn)))
-        with open(self.folder + ".pvd", "w") as f:
-            f.write('<?xml version="1.0"?>\n<VTKFile type="Collection">\n'
-                    '<Collection>\n')
-            for t, name in self.entries:
-                f.write('<DataSet timestep="{:.6g}" file="{}/{}"/>\n'.format(
-                    t, os.path.basename(self.folder), name))
-            f.write('</Collection>\n</VTKFile>\n')
+    def write(fn):
+        import meshio
+        from skfem.io.meshio import to_meshio
+        m = to_meshio(basis.mesh, encode_cell_data=False)
+        m.point_data = {"u": u.reshape(-1, 3)}
+        m.cell_data = {"ep": [np.asarray(ep)]}
+        meshio.write(fn, m)
+    return write
 
 
 def run(sc, solved, series=None, verbose=False):
@@ -162,7 +151,7 @@ def run(sc, solved, series=None, verbose=False):
         ep, ep_max = model.plastic_strain()
         curve["ep"].append(ep_max)
         if series is not None:
-            series.write(basis, u, ep, load * sc.elongation)
+            series.add(load * sc.elongation, write_step(basis, u, ep))
         if verbose:
             print("    {:.3f} mm  F {:.2f} kN  r {:.3f} mm  ep {:.3f}".format(
                 curve["disp"][-1], curve["force"][-1], curve["radius"][-1],
@@ -238,7 +227,7 @@ def main(n=1, overkill=3, methods=None, results=None, out=None,
         folder = os.path.join(out, "necking", solved.replace(" ", "_")
                               .replace("+", "p"))
         rows[label] = r = run(whole if on_whole else sc, solved,
-                              Series(folder), verbose)
+                              VTUSeries(folder), verbose)
         print("    {}: {} steps, max e_p {}, {:.0f} s".format(
             r["status"], r["steps"], "–" if r["curve"] is None else
             "{:.3f}".format(r["curve"]["ep"][-1]), r["seconds"]),

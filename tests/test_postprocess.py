@@ -55,3 +55,23 @@ def test_vtu_cells_in_3d_and_subsets(tmp_path, kind):
     centroids = pg.Particles.from_mesh(mesh, kind="centroids")
     pg.write_vtu(fn, centroids)
     assert meshio.read(fn).cells[0].type == "vertex"
+
+
+def test_vtu_series_lists_its_steps(tmp_path):
+    """A .pvd collection naming every step's VTU with its time, readable
+    after each step; the files are the particles with their fields."""
+    import re
+    import meshio
+    from skfem_pg.scenes.io import VTUSeries
+    mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 3)] * 2)
+    p = pg.Particles.from_mesh(mesh)
+    series = VTUSeries(str(tmp_path / "run"))
+    for t in (0.25, 0.5, 1.0):
+        series.add(t, lambda fn: pg.write_vtu(fn, p, a=np.full(p.n, t)))
+        pvd = (tmp_path / "run.pvd").read_text()
+        listed = re.findall(r'timestep="([^"]+)" file="([^"]+)"', pvd)
+        assert [float(s) for s, _ in listed][-1] == t
+    assert [f for _, f in listed] == ["run/step_{:03d}.vtu".format(k)
+                                      for k in range(3)]
+    last = meshio.read(str(tmp_path / listed[-1][1]))
+    assert np.all(last.point_data["a"] == 1.0)

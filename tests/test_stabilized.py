@@ -256,7 +256,7 @@ def test_ppg_unlp0_refused_where_unstable():
     """PPG UnlP0 in 3-D with the min-norm (or p) VC: its tangent at rest
     has eigenvalues with negative real part (here measured again), so
     the model refuses it; with 'sn' it is stable."""
-    import skfem_pg.formulations.master_dilatation as md
+    from skfem_pg.formulations.master_dilatation import MasterDilatation
     from skfem_pg.scenes import Scene
     mesh = cube(4).with_boundaries({"a": lambda x: x[0] < 1e-9,
                                     "b": lambda x: x[0] > 1 - 1e-9})
@@ -266,11 +266,12 @@ def test_ppg_unlp0_refused_where_unstable():
     for name, unstable in (("VCBCPPG V3m UnlP0", True),
                            ("VCBCPPG V3sn UnlP0", False)):
         if unstable:  # build it as it was before the check
-            saved, md.UNSTABLE_3D = md.UNSTABLE_3D, ()
+            saved = MasterDilatation.unstable_3d
+            MasterDilatation.unstable_3d = ()
             try:
                 _, model, _, D, _, _ = sc.setup(name)
             finally:
-                md.UNSTABLE_3D = saved
+                MasterDilatation.unstable_3d = saved
         else:
             _, model, _, D, _, _ = sc.setup(name)
         K = model.tangent(model.state(model.initial()))

@@ -44,7 +44,6 @@ direct solver).  p and Θ are global even in explicit runs, the cost the
 thesis notes.
 """
 import numpy as np
-import scipy.sparse as sp
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
@@ -183,17 +182,21 @@ class NodalPressure(Hyperelastic):
         p_pts, Th_pts = self._at_points(p), self._at_points(Theta)
         s = {"p": p_pts, "Theta": Th_pts}
         if self.bubble:
-            F, ub, Kbb = self._solve_bubble(F, p_pts)
+            F, ub, Kbb, vol = self._solve_bubble(F, p_pts)
             s.update(ub=ub, Kbb=Kbb)
-        Finv, J, P = self._volumetric(F, p_pts)
+        else:
+            vol = None
+        # the bubble's Newton ends with the stresses at F: not again
+        Finv, J, P = self._volumetric(F, p_pts) if vol is None else vol
         s.update(F=F, Finv=Finv, J=J, P=P)
         return s
 
     def _solve_bubble(self, Fu, p):
         """The bubble amplitudes ``(d, n_f)`` with :math:`R_b = 0`, by a
-        batched Newton from the last ones (and, should that fail — e.g.
-        the last ones belong to another run —, from zero); also
-        :math:`K_{bb}`."""
+        batched Newton from the last ones; should that fail (the last
+        iterate of a cut step, another run's), from the last converged
+        step's, then from zero; also :math:`K_{bb}` and ``(Finv, J, P)``
+        at the resulting F (``None`` if it failed)."""
         error = None
         for start in (self._ub, self._ub_committed,
                       np.zeros_like(self._ub)):
@@ -202,15 +205,13 @@ class NodalPressure(Hyperelastic):
             except ReturnMapError as err:  # a plastic material's local
                 error = err  # Newton at an iterate: try the next start
                 continue
-            # a root with J <= 0 (from the last iterate of a step that
-            # failed) is no bubble: try the next start
-            if out is not None and inverse_and_det(out[0])[1].min() > 0:
+            if out is not None:
                 self._ub = out[1]
                 return out
         if error is not None:  # Newton cuts the step, naming the reason
             raise error
         # no convergence (e.g. J <= 0 inside a family): let Newton cut
-        return np.full_like(Fu, np.nan), self._ub, None
+        return np.full_like(Fu, np.nan), self._ub, None, None
 
     def _bubble_newton(self, Fu, p, ub):
         """Newton on :math:`R_b^k(u_b^k) = 0`, every family at once (a
@@ -219,7 +220,8 @@ class NodalPressure(Hyperelastic):
         and halved, family by family, until that family's residual
         decreases (a plastic material's elastic–plastic switch made the
         full steps cycle between two states).  ``None`` if it does not
-        converge."""
+        converge, or converges to a root with J <= 0 somewhere (reached
+        from the last iterate of a failed step: no bubble)."""
         E, b = self.elements, self._b
         bn = np.abs(b).max()
 
@@ -227,9 +229,9 @@ class NodalPressure(Hyperelastic):
             F = Fu + E.spread(ub)[:, None] * b[None]
             Finv, J, P = self._volumetric(F, p)
             Rb = E.sum(np.einsum("iJ...,J...->i...", P, b))  # (d, nf)
-            return F, Finv, J, Rb
+            return F, Finv, J, P, Rb
 
-        F, Finv, J, Rb = residual(ub)
+        F, Finv, J, P, Rb = residual(ub)
         for it in range(BUBBLE_MAXITER):
             A = self._tangent_field(F, Finv, J, p)
             Kbb = E.sum(np.einsum("iJkL...,J...,L...->ik...", A, b, b))
@@ -242,14 +244,17 @@ class NodalPressure(Hyperelastic):
                 return None
             step = np.abs(dub).max(axis=0) * bn  # the bubble's strain
             if step.max() <= BUBBLE_TOL:
-                ub = ub + dub
-                return Fu + E.spread(ub)[:, None] * b[None], ub, Kbb
+                if not J.min() > 0:
+                    return None
+                # converged: the last step (below BUBBLE_TOL of strain)
+                # is not taken, so F, its stresses and K_bb agree
+                return F, ub, Kbb, (Finv, J, P)
             t = np.minimum(1.0, BUBBLE_STEP / np.maximum(step, 1e-300))
             r0 = np.linalg.norm(Rb, axis=0)
             for _ in range(BUBBLE_HALVINGS):
                 try:
                     trial = residual(ub + dub * t)
-                    worse = np.linalg.norm(trial[3], axis=0) > r0 * (
+                    worse = np.linalg.norm(trial[4], axis=0) > r0 * (
                         1 - 1e-4 * t)
                     worse &= step * t > BUBBLE_TOL  # round-off: accept
                 except ReturnMapError as err:  # too wild: all shorter
@@ -262,7 +267,7 @@ class NodalPressure(Hyperelastic):
                 if trial is None:
                     raise error
             ub = ub + dub * t
-            F, Finv, J, Rb = trial
+            F, Finv, J, P, Rb = trial
         return None
 
     def commit(self, state):

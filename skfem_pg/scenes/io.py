@@ -1,4 +1,7 @@
-"""VTU output of particle fields for ParaView (via meshio)."""
+"""VTU output of particle fields for ParaView (via meshio), and time
+series of them (``.pvd`` collections)."""
+import os
+
 import numpy as np
 import meshio
 
@@ -50,3 +53,31 @@ def _cells(particles):
             t = t[np.asarray(particles.elements)]
         return [(block.type, t)]
     return [("vertex", np.arange(particles.n).reshape(-1, 1))]
+
+
+class VTUSeries:
+    """A time series for ParaView: ``folder/step_NNN.vtu`` per step and
+    the collection ``folder + ".pvd"`` that lists them with their times,
+    rewritten after each step (an interrupted run leaves a readable
+    series).  ``add(t, write)`` calls ``write(filename)`` — e.g.
+    :func:`write_vtu` of the particles, or meshio for an FE mesh — and
+    returns the file's name."""
+
+    def __init__(self, folder):
+        self.folder, self.entries = folder, []
+        os.makedirs(folder, exist_ok=True)
+
+    def add(self, t, write):
+        fn = os.path.join(self.folder, "step_{:03d}.vtu".format(
+            len(self.entries)))
+        write(fn)
+        self.entries.append((float(t), os.path.basename(fn)))
+        sub = os.path.basename(os.path.normpath(self.folder))
+        with open(os.path.normpath(self.folder) + ".pvd", "w") as f:
+            f.write('<?xml version="1.0"?>\n<VTKFile type="Collection">\n'
+                    '<Collection>\n')
+            for time, name in self.entries:
+                f.write('<DataSet timestep="{:.9g}" file="{}/{}"/>\n'.format(
+                    time, sub, name))
+            f.write('</Collection>\n</VTKFile>\n')
+        return fn

@@ -17,33 +17,21 @@ def rigid_body_modes(doflocs, components=None):
     the dofs are a subset (free dofs with sliding boundaries: not whole
     nodes); default: interleaved whole nodes (``j % d``)."""
     d, N = doflocs.shape
-    if components is not None:
-        c = np.asarray(components)
-        if c.shape != (N,):
-            raise ValueError("components: one per dof ({}), got {}".format(
-                N, c.shape))
-        modes = [(c == a).astype(float) for a in range(d)]
-        for a in range(d):
-            for b in range(a + 1, d):
-                modes.append(np.where(c == a, -doflocs[b], 0.0)
-                             + np.where(c == b, doflocs[a], 0.0))
-        return np.column_stack(modes)
-    if N % d:
-        raise ValueError("{} dofs are not whole nodes of {} components: "
-                         "pass components=".format(N, d))
-    x = doflocs[:, ::d]
-    n = x.shape[1]
-    modes = []
-    for a in range(d):
-        m = np.zeros((n, d))
-        m[:, a] = 1.0
-        modes.append(m)
+    if components is None:
+        if N % d:
+            raise ValueError("{} dofs are not whole nodes of {} components:"
+                             " pass components=".format(N, d))
+        components = np.arange(N) % d
+    c = np.asarray(components)
+    if c.shape != (N,):
+        raise ValueError("components: one per dof ({}), got {}".format(
+            N, c.shape))
+    modes = [(c == a).astype(float) for a in range(d)]
     for a in range(d):
         for b in range(a + 1, d):
-            m = np.zeros((n, d))
-            m[:, a], m[:, b] = -x[b], x[a]
-            modes.append(m)
-    return np.column_stack([m.ravel() for m in modes])
+            modes.append(np.where(c == a, -doflocs[b], 0.0)
+                         + np.where(c == b, doflocs[a], 0.0))
+    return np.column_stack(modes)
 
 
 def pardiso_available():
