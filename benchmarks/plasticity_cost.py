@@ -11,7 +11,7 @@ family, at the master; ``vs Unl``: the total against PG Unl's hyperelastic
 iteration).  The batched kernels run
 with the package's default of one BLAS thread (``skfem_pg.threads``).
 
-    python benchmarks/plasticity_cost.py [--n 10]
+    python benchmarks/plasticity_cost.py [--n 10] [--results FILE]
 """
 import time
 
@@ -21,7 +21,8 @@ import skfem as fem
 import skfem_pg as pg
 from skfem_pg.formulations.by_name import model_for
 from skfem_pg.materials import J2Plasticity
-from skfem_pg.scenes.reporting import demo_parser
+from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+                                       update_results)
 from skfem_pg.solvers import linear_solver
 
 STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,
@@ -61,7 +62,7 @@ def iteration(model, basis, D):
 
 
 def main():
-    ap = demo_parser(__doc__)
+    ap = demo_parser(__doc__, results=True)
     ap.add_argument("--n", type=int, default=10)
     args = ap.parse_args()
     n = args.n
@@ -73,7 +74,7 @@ def main():
     print("{:8s} {:10s} {:>7s} {:>7s} {:>7s} {:>7s} {:>7s} {:>8s} {:>6s} "
           "{:>6s}".format("basis", "material", "state", "force", "tangent",
                           "solve", "total", "us/point", "ratio", "vs Unl"))
-    unl = None
+    unl, table = None, []
     pgb = pg.FamilyBasis(mesh, dim=3)
     for label, make, token in [
             ("PG Unl", lambda: pgb, "Unl"),
@@ -98,8 +99,26 @@ def main():
                       label, name, r["state"], r["force"], r["tangent"],
                       r["solve"], tot, "{:.2f}".format(extra)
                       if r["points"] else "-", tot / base, tot / unl))
+            table.append([label, name] + ["{:.3f}".format(v) for v in (
+                r["state"], r["force"], r["tangent"], r["solve"], tot)] + [
+                "{:.1f}".format(extra) if r["points"] else "–",
+                r["points"] or "–", "{:.2f}".format(tot / base),
+                "{:.2f}".format(tot / unl)])
         print("  {} points, {:.0%} plastic".format(rows["J2"]["points"],
                                                    rows["J2"]["plastic"]))
+    if args.results:
+        print("updated", update_results(
+            args.results, "plasticity_cost_{}".format(n),
+            "`python benchmarks/plasticity_cost.py --n {0}`: one Newton "
+            "iteration on the unit cube of {0}^3 hexahedra ({1} nodes), "
+            "stretched 5 % (every point plastic); seconds, best of 3; "
+            "`extra us/point`: the plastic iteration's extra time per "
+            "return-map point; `ratio`: against the same basis' hyperelastic"
+            " iteration, `vs Unl`: against PG Unl's.\n\n".format(
+                n, mesh.nvertices) + markdown_table(
+                ["basis", "material", "state", "force", "tangent", "solve",
+                 "total", "extra us/point", "points", "ratio", "vs Unl"],
+                table)))
 
 
 if __name__ == "__main__":
