@@ -21,6 +21,9 @@ interface of a stateless material (``stress(F)``, ``tangent(F)``,
 The last response is cached (keyed on the identity of ``F``), so the
 stress and the tangent at one state cost one return map.
 """
+import copy
+from contextlib import contextmanager
+
 import numpy as np
 
 
@@ -91,6 +94,22 @@ class History:
         self.committed = None if saved is None else {
             k: np.array(v, dtype=float) for k, v in saved.items()}
         self._last = None
+
+    @contextmanager
+    def elastic_predictor(self):
+        """Within this context the material does not yield: it answers
+        with the elastic trial response from the committed state (the
+        stiffness of elastic unloading in the current configuration, what
+        the stable time step of an explicit run is estimated from)."""
+        material, last = self.material, self._last
+        elastic = copy.copy(material)
+        elastic.yield_stress = lambda alpha: np.full(np.shape(alpha),
+                                                     np.inf)
+        self.material, self._last = elastic, None
+        try:
+            yield self
+        finally:
+            self.material, self._last = material, last
 
     def alpha(self):
         """The committed hardening variable (the accumulated plastic

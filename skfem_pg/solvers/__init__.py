@@ -1,12 +1,23 @@
 """Solvers: linear (sparse direct, AMG-Krylov), the static Newton
 method with adaptive load steps that drives any formulation (and commits
-the history of plastic models per converged step), checkpoints."""
+the history of plastic models per converged step), checkpoints; dynamics:
+lumped mass, implicit Newmark, explicit central differences, a rigid
+frictionless wall, energy bookkeeping."""
 from .linear import (direct, linear_solver, AMGSolver, rigid_body_modes,
                      pardiso_available, DIRECT_LIMIT)
 from .static import newton, ConvergenceError, PG_CANDIDATES
+from .mass import lumped_mass
+from .dynamics import DynamicsError, Trajectory, EnergyBalance
+from .contact import RigidWall
+from .newmark import newmark
+from .explicit import (central_difference, stable_time_step,
+                       max_frequency)
 from . import checkpoint
 from ..dofs import as_dofs
 
 __all__ = ["direct", "linear_solver", "AMGSolver", "rigid_body_modes",
            "pardiso_available", "DIRECT_LIMIT", "newton",
-           "ConvergenceError", "PG_CANDIDATES", "as_dofs", "checkpoint"]
+           "ConvergenceError", "PG_CANDIDATES", "as_dofs", "checkpoint",
+           "lumped_mass", "DynamicsError", "Trajectory", "EnergyBalance",
+           "RigidWall", "newmark", "central_difference", "stable_time_step",
+           "max_frequency"]

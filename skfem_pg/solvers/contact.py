@@ -1,0 +1,86 @@
+r"""A rigid frictionless plane wall: the thesis' simplified contact (7.3.7).
+
+The wall is the plane :math:`x_a = c` normal to a coordinate axis ``a``;
+the body lies on the side ``side`` (``+1``: :math:`x_a \ge c`).  It acts
+on the normal displacement dof of each node (particle) alone — no friction,
+the tangential motion stays free — and only by pressure:
+
+* explicit (:func:`~skfem_pg.solvers.central_difference`): a dof whose
+  predicted position lies behind the wall is put on it; a dof on the wall
+  is *held* (zero normal velocity and acceleration) while the free
+  acceleration pushes it into the wall, i.e. while the reaction is
+  compressive, and released as soon as it would pull;
+* implicit (:func:`~skfem_pg.solvers.newmark`): an active set, solved as
+  Dirichlet dofs; after a converged step the dofs with a tensile reaction
+  are released and the free ones behind the wall are activated, and the
+  step is repeated until the set no longer changes.
+
+A held dof is massless while held (its inertia is part of the reaction);
+the kinetic energy an impact destroys is reported as the contact loss
+(:mod:`~skfem_pg.solvers.dynamics`).
+"""
+import numpy as np
+
+
+class RigidWall:
+    """The plane ``x[axis] = position``, the body on ``side`` of it.
+
+    ``tol``: the penetration (a length) below which a dof counts as on the
+    wall; default 1e-9 of the body's extent along ``axis``."""
+
+    def __init__(self, axis, position=0.0, side=1, tol=None):
+        if side not in (1, -1):
+            raise ValueError("side must be +1 or -1, got {!r}".format(side))
+        self.axis, self.position, self.side = int(axis), float(position), side
+        self.tol = tol
+
+    def __repr__(self):
+        return "RigidWall(axis={}, position={}, side={:+d})".format(
+            self.axis, self.position, self.side)
+
+    def bind(self, basis, n_u, D):
+        """The candidate dofs (component ``axis`` of every node, except
+        prescribed ones) and their reference coordinates; checks that the
+        body starts on its side."""
+        locs = basis.doflocs
+        d = locs.shape[0]
+        if not 0 <= self.axis < d:
+            raise ValueError("{!r}: axis {} of a {}-D body".format(
+                self, self.axis, d))
+        dofs = np.setdiff1d(np.arange(self.axis, n_u, d), D)
+        self.dofs = dofs
+        self.X = locs[self.axis, dofs]
+        if self.tol is None:
+            ext = np.ptp(locs[self.axis]) if locs.shape[1] else 1.0
+            self.tol = 1e-9 * max(ext, 1e-300)
+        behind = self.side * (self.X - self.position) < -self.tol
+        if behind.any():
+            i = np.flatnonzero(behind)[0]
+            raise ValueError(
+                "{!r}: {} node(s) start behind the wall, first dof {} at "
+                "{} = {}".format(self, behind.sum(), dofs[i], "xyz"[self.axis],
+                                 self.X[i]))
+        return dofs
+
+    def gap(self, u):
+        """Signed distances of the candidates to the wall (negative:
+        behind it)."""
+        return self.side * (self.X + u[self.dofs] - self.position)
+
+    def wall_values(self):
+        """The displacements that put each candidate on the wall."""
+        return self.position - self.X
+
+    def penetrating(self, u):
+        """Mask of the candidates behind the wall by more than ``tol``."""
+        return self.gap(u) < -self.tol
+
+    def on_wall(self, u):
+        """Mask of the candidates on (or behind) the wall."""
+        return self.gap(u) <= self.tol
+
+    def compressive(self, force):
+        """Mask of the candidates whose wall force (``force``: the force
+        the wall must exert on each candidate dof to hold it) pushes the
+        body away from the wall."""
+        return self.side * force > 0

@@ -1,0 +1,175 @@
+r"""What the time integrators share: loads and prescribed motion as
+functions of time, the energy balance, progress lines and the result.
+
+Energy bookkeeping (printed as a run goes and stored per output):
+
+* kinetic :math:`T = \tfrac12 v\cdot M v` (free dofs; prescribed dofs and
+  dofs held by a wall are massless while constrained);
+* internal work :math:`W_{int} = \sum \tfrac12 (f_{int}^n +
+  f_{int}^{n+1})\cdot\Delta u` (trapezoidal, over all dofs): the stored
+  energy plus the plastic dissipation;
+* stored energy :math:`\Pi = \sum w\, W(F)` where the model offers it
+  (``model.energy``), and the dissipation :math:`W_{int} - \Pi`;
+* external work :math:`W_{ext}` of the loads (trapezoidal), work of the
+  reactions at prescribed dofs :math:`W_D` (:math:`R = f_{int} -
+  f_{ext}` there), and the energy the wall took at impacts
+  :math:`D_c` (the work of the contact forces on the dofs they hold, with
+  the sign turned: a rigid wall stops what hits it);
+* the balance error :math:`T + W_{int} + D_c - W_{ext} - W_D - T_0`,
+  relative to the largest energy of the run so far (the initial stored
+  energy included).
+
+For Newmark's average acceleration (β = 1/4, γ = 1/2) the trapezoidal
+works make the balance exact for a linear problem; for central
+differences it holds to :math:`O(\Delta t^2)` with no drift.
+"""
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .static import _padded
+
+
+def time_functions(model, f_ext, u_D):
+    """``f(t)`` and ``u_D(t)`` as full-length vectors (one entry per
+    unknown) from a vector, a callable of the time or ``None``."""
+    N = getattr(model, "N", model.basis.N)
+    n_u = getattr(model, "n_u", N)
+
+    def wrap(v, what):
+        if callable(v):
+            return lambda t: _padded(v(t), n_u, N, what + "(t)")
+        c = _padded(v, n_u, N, what)
+        return lambda t: c
+    return wrap(f_ext, "f_ext"), wrap(u_D, "u_D")
+
+
+class EnergyBalance:
+    """The energies of a run (module docstring), updated per step."""
+
+    def __init__(self, m, v0, free, stored0=None):
+        self.m = m
+        self.T0 = self.kinetic(v0, free)
+        self.W_int = self.W_ext = self.W_D = self.D_c = 0.0
+        # the energy scale of the relative error: the largest energy met
+        # so far (the initial stored one included)
+        self.scale = max(self.T0, abs(stored0 or 0.0), 1e-300)
+
+    def kinetic(self, v, free):
+        n = self.m.shape[0]
+        vf = np.where(free, v[:n], 0.0)
+        return 0.5 * float(np.dot(self.m, vf * vf))
+
+    def step(self, du, fi0, fi1, fe0, fe1, D, held=None, v0=None, v1=None,
+             free0=None, free1=None):
+        """Add a step: displacement increment ``du`` (all unknowns),
+        internal and external forces before and after, prescribed dofs
+        ``D``; ``held``: the dofs a wall constrained during the step
+        (their velocities ``v0``, ``v1`` and whether they were free)."""
+        n = self.m.shape[0]
+        du = du[:n]
+        fi, fe = 0.5 * (fi0[:n] + fi1[:n]), 0.5 * (fe0[:n] + fe1[:n])
+        self.W_int += float(np.dot(fi, du))
+        self.W_ext += float(np.dot(fe, du))
+        self.W_D += float(np.dot(fi[D] - fe[D], du[D]))
+        if held is not None and held.size:
+            m = self.m[held]
+            k0 = np.where(free0[held], v0[held] ** 2, 0.0)
+            k1 = np.where(free1[held], v1[held] ** 2, 0.0)
+            # work of the contact force on the held dofs = their kinetic
+            # change + their internal minus external work
+            w = 0.5 * np.dot(m, k1 - k0) + np.dot(fi[held] - fe[held],
+                                                   du[held])
+            self.D_c -= float(w)
+
+    def record(self, t, v, free, stored=None):
+        """The energies at time ``t`` as a dict (with the balance
+        error, absolute and relative)."""
+        T = self.kinetic(v, free)
+        err = T + self.W_int + self.D_c - self.W_ext - self.W_D - self.T0
+        self.scale = scale = max(self.scale, T, abs(self.W_int),
+                                 abs(self.W_ext), abs(self.W_D),
+                                 abs(self.D_c), abs(stored or 0.0))
+        out = {"t": float(t), "kinetic": T, "internal_work": self.W_int,
+               "external_work": self.W_ext, "prescribed_work": self.W_D,
+               "contact_loss": self.D_c, "error": err,
+               "relative_error": err / scale}
+        if stored is not None:
+            out["stored"] = stored
+            out["dissipation"] = self.W_int - stored
+        return out
+
+
+class DynamicsError(RuntimeError):
+    """A time integration could not continue (no convergence at the
+    smallest step, an inverted point, a failed return map, an explicit
+    run going unstable).  ``t``, ``x``, ``v`` and ``history`` hold the
+    last good state."""
+
+    def __init__(self, message, t=0.0, x=None, v=None, history=None):
+        super().__init__(message)
+        self.t, self.x, self.v = t, x, v
+        self.history = history or []
+
+
+@dataclass
+class Trajectory:
+    """A time integration's result: the unknowns ``x`` (displacements
+    first), velocities ``v`` and accelerations ``a`` at the final time
+    ``t``; ``history``: the energies (:class:`EnergyBalance`) and step
+    data per output; ``steps``; ``times``: wall seconds by part."""
+    x: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    t: float
+    history: list = field(default_factory=list)
+    steps: int = 0
+    times: dict = field(default_factory=dict)
+
+    def series(self, key):
+        """One recorded quantity over the outputs, as an array."""
+        return np.array([h[key] for h in self.history])
+
+
+class Progress:
+    """A progress line at every tenth (``parts``) of the simulated time:
+    time, step size, steps per second, energies and the balance
+    error."""
+
+    def __init__(self, t_end, verbose, parts=10, stream=None):
+        self.t_end, self.verbose, self.parts = t_end, verbose, parts
+        self.next, self.t0 = 0, time.perf_counter()
+        self.stream = stream or sys.stdout
+
+    def __call__(self, t, dt, steps, energies, force=False):
+        if not self.verbose:
+            return
+        frac = t / self.t_end if self.t_end > 0 else 1.0
+        if not force and frac < self.next / self.parts - 1e-12:
+            return
+        while self.next / self.parts <= frac + 1e-12:
+            self.next += 1
+        wall = time.perf_counter() - self.t0
+        e = energies
+        print("  t {:.4g} ({:3.0f} %)  dt {:.3g}  {} steps, {:.0f}/s  "
+              "T {:.4g}  W_int {:.4g}  W_ext {:.4g}  D_c {:.3g}  "
+              "energy error {:.2e}".format(
+                  t, 100 * frac, dt, steps, steps / max(wall, 1e-9),
+                  e["kinetic"], e["internal_work"],
+                  e["external_work"] + e["prescribed_work"],
+                  e["contact_loss"], e["relative_error"]),
+              file=self.stream, flush=True)
+
+
+def stored_energy(model, state):
+    """``model.energy(state)`` where the model offers it, else
+    ``None``."""
+    f = getattr(model, "energy", None)
+    if f is None:
+        return None
+    try:
+        return float(f(state))
+    except (NotImplementedError, TypeError):
+        return None

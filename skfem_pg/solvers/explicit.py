@@ -1,0 +1,291 @@
+r"""Explicit central differences (thesis 4.4.1, (4.38)–(4.40)).
+
+With the particle discretization's diagonal mass the equations of motion
+decouple: a step is one internal-force evaluation and no global solve.
+The scheme is written in its velocity (Verlet) form, which for a constant
+step is (4.38)–(4.40) exactly and also admits a changing step:
+
+.. math::
+
+    v_{n+1/2} = v_n + \tfrac{\Delta t}2 a_n,\quad
+    u_{n+1} = u_n + \Delta t\, v_{n+1/2},\quad
+    a_{n+1} = M^{-1}\big(f_{ext}(t_{n+1}) - f_{int}(u_{n+1})\big),\quad
+    v_{n+1} = v_{n+1/2} + \tfrac{\Delta t}2 a_{n+1}.
+
+A material's history is committed after every step (4.4.2).  The
+formulations whose mixed fields are continuous (U2P1C, Unl+P1C) and the
+incompressible ones (IUnlP0) carry global unknowns beyond the
+displacements and need a global solve every step (6.2.3): they are
+refused here and run with :func:`~skfem_pg.solvers.newmark`.
+
+Stable step (not in the thesis, which cites the CFL condition):
+:math:`\Delta t = s \cdot 2/\omega_{max}`, :math:`\omega_{max}^2 =
+\lambda_{max}(M^{-1}K)` of the tangent in the current configuration with
+the material held elastic (:meth:`History.elastic_predictor
+<skfem_pg.formulations.history.History.elastic_predictor>`: the plastic
+tangent is softer than elastic unloading, which sets the limit),
+by Lanczos iterations (``scipy.sparse.linalg.eigsh``) on
+:math:`M^{-1/2} K M^{-1/2}`; re-estimated every ``estimate_every`` steps
+as the configuration changes.  A run whose energy balance error exceeds
+``max_energy_error`` stops with :class:`DynamicsError` — the signature of
+an unstable step — instead of returning garbage.
+"""
+import contextlib
+import time
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.linalg import eigsh
+
+from ..dofs import as_dofs
+from ..materials import ReturnMapError
+from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
+                       stored_energy, time_functions)
+
+
+#: steps before the energy check starts: an impulsive start (a velocity
+#: prescribed from rest) errs by several per cent of the tiny energies of
+#: the first steps (8 % at step 1, 0.4 % at step 10 in the wave-arrival
+#: test) and then settles; an unstable step grows without bound
+STARTUP_STEPS = 10
+
+
+def _elastic(model):
+    h = getattr(model, "history", None)
+    return h.elastic_predictor() if h is not None else \
+        contextlib.nullcontext()
+
+
+def max_frequency(model, m, x, free=None, tol=1e-3):
+    r""":math:`\omega_{max} = \sqrt{\lambda_{max}(M^{-1}K)}` of the
+    tangent at ``x`` on the ``free`` displacement dofs (default all with
+    mass), the material held elastic; the symmetric part of a
+    Petrov–Galerkin tangent."""
+    n_u = m.shape[0]
+    free = m > 0 if free is None else free & (m > 0)
+    with _elastic(model):
+        K = model.tangent(model.state(x)).tocsr()[:n_u, :n_u]
+    idx = np.flatnonzero(free)
+    s = sp.diags(1.0 / np.sqrt(m[idx]))
+    K = K[idx][:, idx]
+    S = s @ (0.5 * (K + K.T)) @ s
+    if S.shape[0] <= 50:
+        return float(np.sqrt(max(np.linalg.eigvalsh(S.toarray()).max(),
+                                 0.0)))
+    v0 = np.random.default_rng(0).random(S.shape[0]) + 0.5
+    lam = eigsh(S, k=1, which="LA", tol=tol, v0=v0,
+                ncv=min(S.shape[0] - 1, 24), return_eigenvectors=False,
+                maxiter=5000)
+    return float(np.sqrt(max(lam[0], 0.0)))
+
+
+def stable_time_step(model, m, x=None, free=None, safety=0.8):
+    r"""The central-difference step :math:`s \cdot 2/\omega_{max}`
+    (:func:`max_frequency`) at ``x`` (default the initial unknowns)."""
+    x = model.initial() if x is None else x
+    w = max_frequency(model, m, x, free)
+    if not w > 0:
+        raise ValueError("no stiffness on the free dofs (omega_max = {}): "
+                         "no stable step".format(w))
+    return safety * 2.0 / w
+
+
+def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
+                       u0=None, v0=None, dt=None, safety=0.8,
+                       estimate_every=100, wall=None, callback=None,
+                       output_every=None, max_energy_error=0.05,
+                       verbose=True):
+    r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
+    ``t_end`` by central differences.
+
+    Parameters
+    ----------
+    model
+        A displacement-only model (Unl, UnlP0, U1SUnl, U1SIG, FE; no global
+        extra fields).
+    m
+        Diagonal mass per displacement dof (:func:`lumped_mass`).
+    f_ext, u_D
+        External forces and prescribed displacements: vectors (constant)
+        or callables of the time; ``D`` the prescribed dofs.
+    u0, v0
+        Initial displacements and velocities (default zero).
+    dt
+        Fixed step; default ``safety · 2/ω_max`` (:func:`stable_time_step`),
+        re-estimated every ``estimate_every`` steps.
+    wall
+        A :class:`~skfem_pg.solvers.RigidWall` (or a list of them).
+    callback
+        ``callback(t, x, v, record)`` at the start, every
+        ``output_every`` steps (default: about 20 outputs, guessed from
+        the first step) and at the end; ``record``: the energies.
+    max_energy_error
+        Stop with :class:`DynamicsError` when the relative energy balance
+        error exceeds this (checked from step :data:`STARTUP_STEPS` on).
+
+    Returns
+    -------
+    Trajectory
+        The final state, the energies per output and the seconds spent in
+        force evaluation (``force``), history commits (``commit``), step
+        estimates (``estimate``), contact (``contact``) and output
+        (``output``).
+    """
+    n_u = getattr(model, "n_u", model.basis.N)
+    if getattr(model, "N", n_u) != n_u:
+        raise ValueError(
+            "{} has global unknowns beyond the displacements ({} of {}): "
+            "explicit steps would need a global solve (6.2.3); integrate "
+            "it with newmark".format(type(model).__name__,
+                                     model.N - n_u, model.N))
+    m = np.asarray(m, dtype=float)
+    if m.shape != (n_u,):
+        raise ValueError("the mass needs one entry per displacement dof "
+                         "({}), got shape {}".format(n_u, m.shape))
+    Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
+    f_of, uD_of = time_functions(model, f_ext, u_D)
+    walls = [] if wall is None else (list(wall) if isinstance(
+        wall, (list, tuple)) else [wall])
+    cand = [w.bind(model.basis, n_u, Dd) for w in walls]
+    u = model.initial() if u0 is None else np.asarray(u0, float).copy()
+    v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
+    if u.shape != (n_u,) or v.shape != (n_u,):
+        raise ValueError("u0 and v0 need {} entries".format(n_u))
+    u[Dd] = uD_of(0.0)[Dd]
+    free = np.ones(n_u, dtype=bool)
+    free[Dd] = False
+    inv_m = np.where(free, 1.0 / m, 0.0)
+    times = dict.fromkeys(("force", "commit", "estimate", "contact",
+                           "output"), 0.0)
+    t0 = time.perf_counter()
+    state = _evaluate(model, u, 0.0, None, v)
+    fi = model.internal_force(state)
+    times["force"] += time.perf_counter() - t0
+    fe = f_of(0.0)
+    a = inv_m * (fe - fi)
+    held = np.zeros(n_u, dtype=bool)  # dofs a wall holds
+    energy = EnergyBalance(m, v, free, stored_energy(model, state))
+    for w, c in zip(walls, cand):  # on the wall at the start: held if
+        # moving or pushed into it
+        on = w.on_wall(u)
+        into = w.side * (v[c] + a[c]) < 0
+        h = c[on & into]
+        held[h] = True
+        energy.D_c += 0.5 * float(np.dot(m[h], v[h] ** 2))
+        v[h], a[h] = 0.0, 0.0
+    hist = []
+    t, steps = 0.0, 0
+    progress = Progress(t_end, verbose)
+
+    def output(force_progress=False):
+        t1 = time.perf_counter()
+        rec = energy.record(t, v, free & ~held, stored_energy(model, state))
+        rec.update(dt=step, steps=steps, active=int(held.sum()))
+        hist.append(rec)
+        progress(t, step, steps, rec, force=force_progress)
+        if callback is not None:
+            callback(t, u, v, rec)
+        times["output"] += time.perf_counter() - t1
+
+    step = dt
+    if step is None:
+        t1 = time.perf_counter()
+        step = stable_time_step(model, m, u, free, safety)
+        times["estimate"] += time.perf_counter() - t1
+    if output_every is None:
+        output_every = max(1, int(round(t_end / step / 20)))
+    output()
+    wall_clock = time.perf_counter()
+    while t < t_end * (1 - 1e-12):
+        if dt is None and steps and steps % estimate_every == 0:
+            t1 = time.perf_counter()
+            step = stable_time_step(model, m, u, free, safety)
+            times["estimate"] += time.perf_counter() - t1
+        h = min(step, t_end - t)
+        vh = v + 0.5 * h * a
+        un = u + h * vh
+        un[Dd] = uD_of(t + h)[Dd]
+        vh[Dd] = (un[Dd] - u[Dd]) / h
+        t1 = time.perf_counter()
+        was_held = held.copy()
+        for w, c in zip(walls, cand):  # behind the wall: onto it
+            pen = w.penetrating(un) | held[c]
+            un[c[pen]] = w.wall_values()[pen]
+            vh[c[pen]] = (un[c[pen]] - u[c[pen]]) / h
+        times["contact"] += time.perf_counter() - t1
+        t1 = time.perf_counter()
+        state = _evaluate(model, un, t + h, hist, v, u)
+        fi_n = model.internal_force(state)
+        t2 = time.perf_counter()
+        if hasattr(model, "commit"):
+            model.commit(state)
+        times["commit"] += time.perf_counter() - t2
+        times["force"] += t2 - t1
+        fe_n = f_of(t + h)
+        a_n = inv_m * (fe_n - fi_n)
+        vn = vh + 0.5 * h * a_n
+        vn[Dd] = vh[Dd]
+        t1 = time.perf_counter()
+        held[:] = False
+        for w, c in zip(walls, cand):  # hold while pushed into the wall
+            on = w.on_wall(un)
+            into = w.side * (vn[c] + 0.5 * h * a_n[c]) < 0
+            hc = c[on & into]
+            held[hc] = True
+            vn[hc], a_n[hc] = 0.0, 0.0
+        touched = np.flatnonzero(held | was_held)
+        times["contact"] += time.perf_counter() - t1
+        energy.step(un - u, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
+                    free & ~was_held, free & ~held)
+        u, v, a, fi, fe = un, vn, a_n, fi_n, fe_n
+        t += h
+        steps += 1
+        rec_err = energy.record(t, v, free & ~held)
+        if abs(rec_err["relative_error"]) > max_energy_error and \
+                steps > STARTUP_STEPS:
+            raise DynamicsError(
+                "central differences: energy balance error {:.3g} > "
+                "{:.3g} at t = {:.6g} (step {}, dt {:.3g}): the step is "
+                "unstable (increase safety margin: safety < {})".format(
+                    rec_err["relative_error"], max_energy_error, t, steps,
+                    h, safety), t=t, x=u, v=v, history=hist)
+        if steps % output_every == 0 or t >= t_end * (1 - 1e-12):
+            output(force_progress=t >= t_end * (1 - 1e-12))
+        else:
+            progress(t, h, steps, rec_err)
+    times["total"] = time.perf_counter() - wall_clock
+    return Trajectory(u, v, a, t, hist, steps, times)
+
+
+def _evaluate(model, u, t, hist, v, u_last=None):
+    """``model.state(u)`` with the checks of a step: a return map that
+    fails or an inverted point stops the run with the time."""
+    try:
+        state = model.state(u)
+    except ReturnMapError as err:
+        raise DynamicsError("return map failed at t = {:.6g}: {}".format(
+            t, err), t=t, x=u_last, v=v, history=hist) from None
+    J = model.min_J(state)
+    if not J > 0:
+        raise DynamicsError("an inverted point (min J = {:.3g}) at t = "
+                            "{:.6g}{}".format(J, t, inversion_note(model, u)),
+                            t=t, x=u_last, v=v, history=hist)
+    return state
+
+
+def inversion_note(model, u):
+    """The inversion diagnostic for an error message: how many cells of
+    the collocation mesh the displacements ``u`` turn inside out
+    (:func:`~skfem_pg.discretization.particles.inverted_cells`), where
+    the particles came from a mesh's vertices."""
+    p = getattr(model.basis, "particles", None)
+    if p is None or p.kind != "vertices" or p.mesh is None:
+        return ""
+    from ..discretization.particles import inverted_cells
+    bad = inverted_cells(p, u[:model.n_u])
+    if not bad.size:
+        return "; no cell of the collocation mesh is inverted"
+    x = p.mesh.p[:, p.mesh.t[:, bad[0]]].mean(axis=1)
+    return "; {} cell(s) of the collocation mesh inverted, first {} at " \
+        "({})".format(bad.size, bad[0], ", ".join("{:.4g}".format(c)
+                                                   for c in x))

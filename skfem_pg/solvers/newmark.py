@@ -1,0 +1,266 @@
+r"""Implicit Newmark-β time integration with Newton's method per step and
+adaptive steps (thesis 4.4.1, (4.36)–(4.37)).
+
+With :math:`\tilde u = u_n + \Delta t\, v_n + \Delta t^2 (\tfrac12 -
+\beta) a_n`,
+
+.. math::
+
+    a_{n+1} = \frac{u_{n+1} - \tilde u}{\beta \Delta t^2},\qquad
+    v_{n+1} = v_n + \Delta t\big((1-\gamma) a_n + \gamma a_{n+1}\big),
+
+which is (4.36) with :math:`\gamma/(\beta\Delta t)` (the thesis prints
+:math:`\Delta t^2`, a misprint) and (4.37).  Each step solves
+:math:`r(u) = f_{int}(u) + M a_{n+1}(u) - f_{ext}(t_{n+1}) = 0` by Newton's
+method with the effective tangent :math:`K + M/(\beta\Delta t^2)` (4.53),
+for any model: mixed fields without mass are algebraic unknowns of the
+same system.  β = 1/4, γ = 1/2 (average acceleration) conserves the
+energy of a linear problem exactly and is unconditionally stable.
+
+Adaptive steps: a step whose Newton iteration fails (divergence,
+``maxiter``, :math:`J \le 0`, a failed return map) is halved; after a step
+that converged in at most 4 iterations the step doubles again, up to the
+initial ``dt``.  Below ``dt_min`` the run stops with
+:class:`~skfem_pg.solvers.dynamics.DynamicsError` and the time it reached
+(the failure angle of a twisted prism, thesis 7.3.6).  The history of a
+plastic material is committed after each converged step.
+"""
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..dofs import as_dofs, check_sliding
+from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
+                       stored_energy, time_functions)
+from .static import _condensed_solver, _newton_step
+
+
+class _Inertial:
+    """The model plus the inertia of a Newmark step:
+    :math:`f + M (u - \\tilde u) c`, tangent :math:`K + cM`,
+    :math:`c = 1/(\\beta\\Delta t^2)` (``m`` zero on constrained dofs)."""
+
+    def __init__(self, model, m, c, u_tilde):
+        self.model, self.m, self.c, self.u_tilde = model, m, c, u_tilde
+        self.basis, self.N, self.n_u = model.basis, model.N, model.n_u
+        self.blocks = getattr(model, "blocks", [("u", slice(None))])
+
+    def state(self, x):
+        return (self.model.state(x), x)
+
+    def min_J(self, s):
+        return self.model.min_J(s[0])
+
+    def internal_force(self, s):
+        f = np.array(self.model.internal_force(s[0]), dtype=float)
+        n = self.n_u
+        f[:n] += self.c * self.m * (s[1][:n] - self.u_tilde[:n])
+        return f
+
+    def model_force(self, f, x):
+        """The model's own internal force from the step's ``f`` at
+        ``x``."""
+        f = np.array(f, dtype=float)
+        n = self.n_u
+        f[:n] -= self.c * self.m * (x[:n] - self.u_tilde[:n])
+        return f
+
+    def tangent(self, s):
+        K = self.model.tangent(s[0]).tocsr()
+        diag = np.zeros(self.N)
+        diag[:self.n_u] = self.c * self.m
+        return K + sp.diags(diag)
+
+
+def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
+            v0=None, beta=0.25, gamma=0.5, dt_min=None, tol=1e-8,
+            maxiter=20, solver="auto", wall=None, callback=None,
+            output_every=1, verbose=True, max_contact_passes=20):
+    r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
+    ``t_end`` by Newmark's method (module docstring).
+
+    Parameters
+    ----------
+    model
+        Any model of :mod:`skfem_pg.formulations` (FE or PG, mixed too).
+    m
+        Diagonal mass per displacement dof (:func:`lumped_mass`).
+    dt, dt_min
+        Initial (and largest) step; smallest step before giving up
+        (default ``dt / 1024``).
+    f_ext, D, u_D
+        Loads and prescribed displacements: vectors (constant) or
+        callables of the time; ``D`` the prescribed dofs.
+    u0, v0
+        Initial displacements (or all unknowns) and velocities.
+    tol, maxiter, solver
+        Newton's method per step (:func:`~skfem_pg.solvers.newton`).
+    wall
+        A :class:`~skfem_pg.solvers.RigidWall` (or a list): an active set
+        of held dofs, repeated per step until it settles (at most
+        ``max_contact_passes`` solves).
+    callback
+        ``callback(t, x, v, record)`` at the start and every
+        ``output_every`` converged steps, and at the end.
+
+    Returns
+    -------
+    Trajectory
+        Final unknowns, velocities and accelerations, energies and step
+        data (``dt``, Newton ``iterations``, ``cuts``) per output, the
+        seconds of assembly, linear solves and output.
+    """
+    basis = model.basis
+    N = getattr(model, "N", basis.N)
+    n_u = getattr(model, "n_u", N)
+    m = np.asarray(m, dtype=float)
+    if m.shape != (n_u,):
+        raise ValueError("the mass needs one entry per displacement dof "
+                         "({}), got shape {}".format(n_u, m.shape))
+    if not (0 < beta and 0 < gamma):
+        raise ValueError("beta and gamma must be positive")
+    Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
+    check_sliding(basis, Dd)
+    f_of, uD_of = time_functions(model, f_ext, u_D)
+    walls = [] if wall is None else (list(wall) if isinstance(
+        wall, (list, tuple)) else [wall])
+    cand = [w.bind(basis, n_u, Dd) for w in walls]
+    dt_min = dt / 1024 if dt_min is None else dt_min
+    x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
+    x = x0.copy()
+    if u0 is not None:
+        u0 = np.asarray(u0, dtype=float)
+        x[:u0.shape[0]] = u0
+    x[Dd] = uD_of(0.0)[Dd]
+    v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
+    free = np.ones(n_u, dtype=bool)
+    free[Dd] = False
+    held = np.zeros(n_u, dtype=bool)
+    times = dict.fromkeys(("assemble", "linear", "output", "contact"), 0.0)
+    state = model.state(x)
+    fi = np.asarray(model.internal_force(state), dtype=float)
+    fe = f_of(0.0)
+    a = np.where(free, (fe[:n_u] - fi[:n_u]) / m, 0.0)
+    energy = EnergyBalance(m, v, free, stored_energy(model, state))
+    for w, c in zip(walls, cand):
+        on = w.on_wall(x)
+        into = w.side * (v[c] + a[c]) < 0
+        h = c[on & into]
+        held[h] = True
+        energy.D_c += 0.5 * float(np.dot(m[h], v[h] ** 2))
+        v[h], a[h] = 0.0, 0.0
+    hist = []
+    t, steps, step, cuts = 0.0, 0, float(dt), 0
+    progress = Progress(t_end, verbose)
+    solvers = {}
+
+    def output(info=None, final=False):
+        t1 = time.perf_counter()
+        rec = energy.record(t, v, free & ~held, stored_energy(model, state))
+        rec.update(dt=step, steps=steps, cuts=cuts,
+                   active=int(held.sum()),
+                   iterations=0 if info is None else
+                   len(info["residuals"]) - 1)
+        hist.append(rec)
+        progress(t, step, steps, rec, force=final)
+        if callback is not None:
+            callback(t, x, v, rec)
+        times["output"] += time.perf_counter() - t1
+
+    output()
+    while t < t_end * (1 - 1e-12):
+        h = min(step, t_end - t)
+        ok, res = _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of,
+                        walls, cand, beta, gamma, tol, maxiter, solver,
+                        solvers, times, max_contact_passes)
+        if not ok:
+            cuts += 1
+            step = h / 2
+            if verbose:
+                print("  t {:.6g}: step {:.3g} failed ({}); halved".format(
+                    t + h, h, res), flush=True)
+            if step < dt_min:
+                raise DynamicsError(
+                    "Newmark: no convergence at t = {:.6g} with the step "
+                    "{:.3g} < dt_min = {:.3g} ({})".format(
+                        t + h, step, dt_min, res),
+                    t=t, x=x, v=v, history=hist)
+            continue
+        xn, vn, an, fi_n, state, held_n, info = res
+        fe_n = f_of(t + h)
+        if hasattr(model, "commit"):
+            model.commit(state)
+        touched = np.flatnonzero(held | held_n)
+        energy.step(xn - x, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
+                    free & ~held, free & ~held_n)
+        x, v, a, fi, fe, held = xn, vn, an, fi_n, fe_n, held_n
+        t += h
+        steps += 1
+        if len(info["residuals"]) <= 5 and step < dt:
+            step = min(2 * step, dt)
+        final = t >= t_end * (1 - 1e-12)
+        if steps % output_every == 0 or final:
+            output(info, final)
+    times["total"] = sum(times.values())
+    return Trajectory(x, v, a, t, hist, steps, times)
+
+
+def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
+          cand, beta, gamma, tol, maxiter, solver, solvers, times,
+          max_passes):
+    """One Newmark step from ``t`` to ``t + h``, repeated while the wall's
+    active set changes: ``(True, (x, v, a, f_int, state, held, info))``
+    or ``(False, reason)``."""
+    n_u = m.shape[0]
+    N = x.shape[0]
+    c = 1.0 / (beta * h * h)
+    u_tilde = x[:n_u] + h * v + h * h * (0.5 - beta) * a
+    start = x.copy()
+    start[:n_u] = u_tilde + beta * h * h * a  # constant acceleration
+    uD = uD_of(t + h)
+    held = held.copy()
+    for _ in range(max_passes):
+        C = np.union1d(Dd, np.flatnonzero(held))
+        values = np.zeros(N)
+        values[Dd] = uD[Dd]
+        for w, cw in zip(walls, cand):
+            values[cw] = w.wall_values()
+        I = np.setdiff1d(np.arange(N), C)
+        key = I.tobytes()
+        if key not in solvers:
+            solvers.clear()  # one active set at a time
+            solvers[key] = solver if callable(solver) else \
+                _condensed_solver(solver, model.basis, I,
+                                  extra_fields=N > n_u)
+        mm = np.where(free & ~held, m, 0.0)
+        inert = _Inertial(model, mm, c, u_tilde)
+        ok, xn, info, state = _newton_step(inert, start, 1.0, f_of(t + h),
+                                           C, values[C], I, solvers[key],
+                                           tol, maxiter)
+        times["assemble"] += info["t_assemble"]
+        times["linear"] += info["t_linear"]
+        if not ok:
+            return False, info["reason"]
+        t1 = time.perf_counter()
+        fi = inert.model_force(info.pop("f_int"), xn)
+        changed = False
+        if walls:
+            R = fi[:n_u] - f_of(t + h)[:n_u]  # what the wall must push
+            for w, cw in zip(walls, cand):
+                hw = held[cw]
+                release = hw & ~w.compressive(R[cw])
+                enter = ~hw & w.penetrating(xn)
+                if release.any() or enter.any():
+                    changed = True
+                    held[cw[release]] = False
+                    held[cw[enter]] = True
+        times["contact"] += time.perf_counter() - t1
+        if not changed:
+            an = np.where(free & ~held, c * (xn[:n_u] - u_tilde), 0.0)
+            vn = v + h * ((1 - gamma) * a + gamma * an)
+            vn[held] = 0.0
+            return True, (xn, vn, an, fi, state[0], held, info)
+        start = xn
+    return False, "the wall's active set did not settle in {} " \
+        "passes".format(max_passes)

@@ -1,0 +1,223 @@
+"""Time integration against closed-form answers: the clamped-free bar's
+first period 4L/c, energy conservation (Newmark exact for a linear
+problem, central differences without drift), the arrival time of a wave,
+a bar bouncing off a rigid wall (contact 2L/c, rebound, release)."""
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg.formulations import Hyperelastic, model_for
+from skfem_pg.materials import J2Plasticity, LinearElastic, NeoHookeIsoVol
+from skfem_pg.solvers import (DynamicsError, RigidWall, central_difference,
+                              lumped_mass, max_frequency, newmark,
+                              stable_time_step)
+
+E, RHO = 100.0, 1.0
+C = np.sqrt(E / RHO)  # nu = 0: the bar's wave speed in plane strain
+ELASTIC = LinearElastic(0.0, E / 2)
+
+
+def bar(L=10.0, nx=20, ny=2, H=1.0):
+    return fem.MeshQuad.init_tensor(
+        np.linspace(0, L, nx + 1), np.linspace(0, H, ny + 1)
+    ).with_boundaries({"left": lambda x: np.isclose(x[0], 0.0)})
+
+
+def basis_of(mesh, kind):
+    if kind == "PG":
+        return pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    return fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()),
+                     intorder=2)
+
+
+def first_mode(basis, L, amplitude=1e-3):
+    X = basis.doflocs
+    u0 = np.zeros(basis.N)
+    u0[0::2] = amplitude * np.sin(0.5 * np.pi * X[0, 0::2] / L)
+    return u0
+
+
+def period(ts, us):
+    """Twice the mean spacing of the zero crossings."""
+    ts, us = np.asarray(ts), np.asarray(us)
+    i = np.flatnonzero(np.sign(us[1:]) != np.sign(us[:-1]))
+    tz = ts[i] - us[i] * (ts[i + 1] - ts[i]) / (us[i + 1] - us[i])
+    return 2 * np.mean(np.diff(tz))
+
+
+@pytest.mark.parametrize("kind", ["PG", "Q1"])
+def test_lumped_mass_is_rho_times_volume(kind):
+    basis = basis_of(bar(), kind)
+    m = lumped_mass(basis, 2.5)
+    assert m.shape == (basis.N,)
+    assert np.isclose(m[0::2].sum(), 2.5 * 10.0) and np.allclose(
+        m[0::2], m[1::2])
+
+
+def test_lumped_mass_refuses_what_it_cannot_lump():
+    mesh = fem.MeshTri.init_tensor(np.linspace(0, 1, 3), np.linspace(0, 1, 3))
+    with pytest.raises(ValueError, match="T2/O2"):
+        lumped_mass(fem.Basis(mesh, fem.ElementVector(fem.ElementTriP2())),
+                    1.0)
+    with pytest.raises(ValueError, match="rho must be positive"):
+        lumped_mass(basis_of(bar(), "PG"), -1.0)
+
+
+@pytest.mark.parametrize("kind", ["PG", "Q1"])
+def test_explicit_bar_period_and_energy_drift(kind):
+    """First longitudinal period within 1 % of 4L/c; the energy balance
+    drifts by less than 0.5 % over 10 periods."""
+    L = 10.0
+    basis = basis_of(bar(L), kind)
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    tip = np.flatnonzero(np.isclose(basis.doflocs[0], L)
+                         & (np.arange(basis.N) % 2 == 0))
+    ts, us = [], []
+    T = 4 * L / C
+    tr = central_difference(
+        model, m, 10 * T, D=basis.get_dofs("left").flatten(),
+        u0=first_mode(basis, L), output_every=1, verbose=False,
+        callback=lambda t, x, v, r: (ts.append(t), us.append(x[tip].mean())))
+    assert abs(period(ts, us) / T - 1) < 0.01
+    err = np.abs(tr.series("relative_error"))
+    assert err.max() < 5e-3
+    # the balance closes: kinetic + stored = the initial stored energy
+    h = tr.history[-1]
+    assert np.isclose(h["kinetic"] + h["stored"],
+                      tr.history[0]["stored"], rtol=5e-3)
+
+
+def test_newmark_conserves_a_linear_problems_energy_exactly():
+    """Average acceleration: T + U constant to round-off (the trapezoidal
+    works are exact); the period within 1 %."""
+    L = 10.0
+    basis = basis_of(bar(L), "PG")
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    tip = np.flatnonzero(np.isclose(basis.doflocs[0], L)
+                         & (np.arange(basis.N) % 2 == 0))
+    ts, us, tot = [], [], []
+    T = 4 * L / C
+
+    def cb(t, x, v, r):
+        ts.append(t)
+        us.append(x[tip].mean())
+        tot.append(r["kinetic"] + r["stored"])
+    tr = newmark(model, m, 2 * T, T / 100, D=basis.get_dofs("left").flatten(),
+                 u0=first_mode(basis, L), callback=cb, verbose=False)
+    assert abs(period(ts, us) / T - 1) < 0.01
+    tot = np.array(tot)
+    assert np.abs(tot / tot[0] - 1).max() < 1e-10
+    assert np.abs(tr.series("relative_error")).max() < 1e-10
+
+
+@pytest.mark.parametrize("method", ["explicit", "newmark"])
+def test_wave_arrival_time(method):
+    """A velocity prescribed at one end of a long bar: the particle
+    velocity at the middle reaches half of it at L/(2c), within 3 %."""
+    L = 40.0
+    basis = basis_of(bar(L, nx=160, ny=1), "PG")
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    D = basis.get_dofs("left").nodal["u^1"]
+    V = 1e-3 * C
+    even = np.arange(basis.N) % 2 == 0
+    probe = np.flatnonzero(np.isclose(basis.doflocs[0], L / 2) & even)
+    rec = []
+    t_end = 0.75 * L / C
+    kw = dict(D=D, u_D=lambda t: np.where(even, V * t, 0.0), verbose=False,
+              callback=lambda t, x, v, r: rec.append((t, v[probe].mean())))
+    if method == "explicit":
+        central_difference(model, m, t_end, output_every=1, **kw)
+    else:
+        newmark(model, m, t_end, t_end / 400, **kw)
+    t, vp = np.array(rec).T
+    i = np.flatnonzero(vp >= 0.5 * V)[0]
+    ta = t[i - 1] + (0.5 * V - vp[i - 1]) * (t[i] - t[i - 1]) / (
+        vp[i] - vp[i - 1])
+    assert abs(ta / (0.5 * L / C) - 1) < 0.03
+    assert vp[0] == 0 and abs(vp[-1] / V - 1) < 0.1
+
+
+@pytest.mark.parametrize("method", ["explicit", "newmark"])
+def test_bar_bounces_off_a_rigid_wall(method):
+    """Elastic impact: the wall holds the bar for 2L/c (within 3 %),
+    releases every dof (no tensile reaction) and the bar leaves with
+    nearly its impact speed; the wall took the first column's kinetic
+    energy (its share of the mass, 1/(2 nx))."""
+    L, nx = 10.0, 40
+    basis = basis_of(bar(L, nx), "PG")
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    V = 0.01 * C
+    v0 = np.where(np.arange(basis.N) % 2 == 0, -V, 0.0)
+    rec = []
+    t_end = 3 * L / C
+    kw = dict(v0=v0, wall=RigidWall(0, 0.0), verbose=False,
+              callback=lambda t, x, v, r: rec.append(
+                  (t, r["active"], np.dot(m[0::2], v[0::2]) / m[0::2].sum())))
+    if method == "explicit":
+        tr = central_difference(model, m, t_end, output_every=1, **kw)
+    else:
+        tr = newmark(model, m, t_end, L / C / 100, **kw)
+    t, active, vx = np.array(rec).T
+    t_off = t[np.flatnonzero(active > 0)[-1] + 1]
+    assert abs(t_off / (2 * L / C) - 1) < 0.03
+    assert active[-1] == 0 and active[0] > 0
+    assert 0.95 < vx[-1] / V <= 1.0
+    loss = tr.history[-1]["contact_loss"] / (0.5 * m[0::2].sum() * V ** 2)
+    assert abs(loss - 1 / (2 * nx)) < 0.2 / (2 * nx)
+    assert np.abs(tr.series("relative_error")).max() < 1e-2
+
+
+def test_explicit_step_above_the_limit_is_refused():
+    """A step 10 % above 2/omega_max grows without bound: the run stops
+    with DynamicsError instead of returning garbage."""
+    L = 10.0
+    basis = basis_of(bar(L), "PG")
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    dt = stable_time_step(model, m, safety=1.0)
+    assert np.isclose(dt, 2 / max_frequency(model, m, model.initial()))
+    D = basis.get_dofs("left").flatten()
+    with pytest.raises(DynamicsError, match="energy balance error"):
+        central_difference(model, m, 400 * dt, D=D, dt=1.1 * dt,
+                           u0=first_mode(basis, L), verbose=False)
+    central_difference(model, m, 400 * dt, D=D, dt=0.99 * dt,
+                       u0=first_mode(basis, L), verbose=False)
+
+
+def test_explicit_refuses_global_mixed_fields():
+    mesh = bar()
+    basis = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2,
+                           shape="WTE2")
+    model = model_for("U2P1C", basis, NeoHookeIsoVol(40.0, 100.0))
+    with pytest.raises(ValueError, match="newmark"):
+        central_difference(model, lumped_mass(basis, 1.0), 1.0,
+                           verbose=False)
+
+
+@pytest.mark.parametrize("method", ["explicit", "newmark"])
+def test_plastic_impact_dissipates_and_commits(method):
+    """A J2 bar hitting the wall hard: plastic strain accumulates (the
+    history is committed per step), the dissipation is positive and the
+    balance still closes."""
+    L = 10.0
+    basis = basis_of(bar(L, nx=20), "PG")
+    material = J2Plasticity.from_young(E, 0.3, sigma_y0=0.5, H=1.0)
+    model = Hyperelastic(basis, material)
+    m = lumped_mass(basis, RHO)
+    V = 0.05 * C
+    v0 = np.where(np.arange(basis.N) % 2 == 0, -V, 0.0)
+    kw = dict(v0=v0, wall=RigidWall(0, 0.0), verbose=False)
+    if method == "explicit":
+        tr = central_difference(model, m, L / C, **kw)
+    else:
+        tr = newmark(model, m, L / C, L / C / 40, **kw)
+    ep = model.plastic_strain()
+    assert ep[1] > 1e-3
+    last = tr.history[-1]
+    assert last["dissipation"] > 0.01 * last["kinetic"]
+    assert abs(last["relative_error"]) < 1e-2
