@@ -74,6 +74,19 @@ def fe_method(name):
     return parts[0] if len(parts) == 1 and parts[0] in FE_NAMES else None
 
 
+#: the formulations the updated Lagrangian frame is built for
+UL_FORMULATIONS = ("Unl", "U1", "U2")
+
+
+def frame_of(name):
+    """``"UL"`` or ``"TL"`` (the default) of a thesis name; ``"TL"`` for
+    FE names."""
+    if fe_method(name) is not None:
+        return "TL"
+    m = _NAME.match(name.strip())
+    return (m.group("frame") if m is not None else None) or "TL"
+
+
 def formulation_of(name):
     """The formulation token of a thesis name (``"UnlP0"`` for
     ``"VCBCPBG V5sn UnlP0 TL"``); FE names give their method
@@ -103,9 +116,13 @@ def parse(name):
     if form not in SHAPES:
         raise ValueError("unknown formulation {!r} in {!r}: one of {}"
                          .format(form, name, ", ".join(SHAPES)))
-    if g["frame"] == "UL":
-        raise NotImplementedError("{!r}: the updated Lagrangian frame (UL) "
-                                  "is not built yet; TL is".format(name))
+    if g["frame"] == "UL" and form not in UL_FORMULATIONS:
+        raise NotImplementedError(
+            "{!r}: the updated Lagrangian frame (UL) is built for the "
+            "displacement formulations {} of PBG".format(
+                name, ", ".join(UL_FORMULATIONS)))
+    if g["frame"] == "UL" and g["method"] != "PBG":
+        raise NotImplementedError("{!r}: UL is built for PBG".format(name))
     method = {"PPG": "PPG1"}.get(g["method"], g["method"])
     first_order = form in FIRST_ORDER
     if g["bc"] and not first_order:

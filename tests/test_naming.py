@@ -75,7 +75,9 @@ def test_bad_names_are_named():
     with pytest.raises(ValueError, match="unknown formulation"):
         parse("VCPBG UnlP1")
     with pytest.raises(NotImplementedError, match="UL"):
-        parse("VCBCPBG V5sn Unl UL")
+        parse("VCBCPBG V5sn UnlP0 UL")
+    with pytest.raises(NotImplementedError, match="UL is built for PBG"):
+        parse("VCPPG Unl UL")
     with pytest.raises(ValueError, match="variant"):
         parse("BCPBG V5sn Unl")
     with pytest.raises(ValueError, match="first-order"):

@@ -53,10 +53,12 @@ class _Block:
     block; ``index`` its elements (families) in the basis, ``G`` and
     ``group`` (family blocks) its unpadded derivatives and size group."""
 
-    def __init__(self, conn, dx, ext_grad, take, index, G=None, group=None):
+    def __init__(self, conn, dx, ext_grad, take, index, G=None, group=None,
+                 grad_t=None):
         self.conn, self.dx, self.ext_grad, self.take = conn, dx, ext_grad, \
             take
         self.index, self.G, self.group = index, G, group
+        self.grad_t = grad_t  # gradients as (ne, nq·d, nloc), or None
         self.ne, self.nloc = conn.shape
         self.nq = dx.shape[1]
 
@@ -75,9 +77,10 @@ class _FamilyView:
         self.shape = (L.n_families, L.m_max)
         self.blocks = [
             _Block(g.members, dx, self._ext_grad(G),
-                   (lambda C, g=g: L.take(C, g, axis=0)), g.families, G, g)
-            for g, G, dx in zip(L, basis.grouped_gradients(),
-                                basis.grouped_weights())]
+                   (lambda C, g=g: L.take(C, g, axis=0)), g.families, G, g,
+                   grad_t=lambda sl, b=b: basis.grouped_gradients_t()[b][sl])
+            for b, (g, G, dx) in enumerate(zip(L, basis.grouped_gradients(),
+                                               basis.grouped_weights()))]
 
     @staticmethod
     def _ext_grad(G):
@@ -87,6 +90,8 @@ class _FamilyView:
             """``Ĝ[k, j, i, β]`` for families ``sl``; β over
             ``channels``."""
             Gs = G[sl]
+            if list(channels) == list(range(1, Gs.shape[-1] + 1)):
+                return Gs  # the gradients alone: no copy
             parts = [np.broadcast_to(np.eye(m), Gs.shape[:3]) if beta == 0
                      else Gs[..., beta - 1] for beta in channels]
             return np.stack(parts, axis=-1)
@@ -407,21 +412,30 @@ def _assemble_linear(form, basis, view, kwargs):
     values = [[_call(form, pv, w) for (_, _, pv) in probes]]
     C, const = _coefficients(values, view)
     C = C[..., 0, :]  # (P,) or (points..., P)
+    # the channels the form uses (an internal force: the gradients only)
+    used = np.asarray(C != 0).reshape(-1, nc, nch).any(axis=(0, 1))
+    ch = [beta for beta in range(nch) if used[beta]] or [0]
+    sel = [a * nch + beta for a in range(nc) for beta in ch]
+    C = C[..., sel]
+    nu = len(ch)
     b = np.zeros(basis.N)
     for blk in view.blocks:
         Cblk = C if const else blk.take(C)
         m, nq = blk.nloc, blk.nq
-        for sl in chunks(blk.ne, nq * m * nc * nch, budget=2 ** 24):
-            Gh = blk.ext_grad(sl, range(nch))
+        for sl in chunks(blk.ne, nq * m * nc * nu, budget=2 ** 24):
             dx = blk.dx[sl]
             nfc = dx.shape[0]
             Cs = np.broadcast_to(Cblk if const else Cblk[sl],
-                                 dx.shape + (nc * nch,)) \
-                .reshape(dx.shape + (nc, nch))
+                                 dx.shape + (nc * nu,)) \
+                .reshape(dx.shape + (nc, nu))
             # f[k, l, c] = sum_j dx sum_γ C[k, j, c, γ] Ĝ[k, j, l, γ]
             X = (dx[..., None, None] * Cs).transpose(0, 2, 1, 3) \
-                .reshape(nfc, nc, nq * nch)
-            Gm = Gh.transpose(0, 1, 3, 2).reshape(nfc, nq * nch, m)
+                .reshape(nfc, nc, nq * nu)
+            if blk.grad_t is not None and ch == list(range(1, nch)):
+                Gm = blk.grad_t(sl)
+            else:
+                Gm = blk.ext_grad(sl, ch).transpose(0, 1, 3, 2).reshape(
+                    nfc, nq * nu, m)
             f = np.swapaxes(X @ Gm, -1, -2)
             dofs = nc * blk.conn[sl][:, :, None] + np.arange(nc)
             b += np.bincount(dofs.ravel(), weights=f.ravel(),

@@ -252,6 +252,12 @@ class FamilyBasis(AbstractBasis):
                 "(dim, n)) or use vc=None")
         self.particles = particles
         self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
+        # what rebuilds this basis on moved particles (updated Lagrange)
+        self.options = dict(
+            shape=shape, bond=bond, vc=vc, method=method, dim=dim,
+            weight_exponent=weight_exponent, vc_solver=vc_solver,
+            vc_exclude=vc_exclude, test_shape=test_shape, lme_mu=lme_mu,
+            vc_boundary=vc_boundary, vc_tolerance=vc_tolerance)
         self.test_shape = test_shape
         self.weight_exponent = weight_exponent
         self.timings = {}
@@ -565,7 +571,7 @@ class FamilyBasis(AbstractBasis):
 
     @G.setter
     def G(self, value):
-        self._G, self._G_groups = value, None
+        self._G, self._G_groups, self._Gt_groups = value, None, None
 
     def grouped_gradients(self):
         """``G`` without padding: per size group ``(nf_b, m, m, d)``."""
@@ -574,6 +580,18 @@ class FamilyBasis(AbstractBasis):
                 np.ascontiguousarray(self._G[g.families, :g.m, :g.m])
                 for g in self.layout]
         return self._G_groups
+
+    def grouped_gradients_t(self):
+        """``G`` per size group in the layout of a gradient-only linear
+        form (an internal force), ``(nf_b, m·d, m)``: rows ``(j, b)``,
+        columns the nodes ``i``; cached (a copy of ``G``), so a time step
+        does not transpose ``G`` again."""
+        if getattr(self, "_Gt_groups", None) is None:
+            self._Gt_groups = [
+                np.ascontiguousarray(G.transpose(0, 1, 3, 2)).reshape(
+                    G.shape[0], -1, G.shape[2])
+                for G in self.grouped_gradients()]
+        return self._Gt_groups
 
     def grouped_weights(self):
         """``dx`` without padding: per size group ``(nf_b, m)``."""

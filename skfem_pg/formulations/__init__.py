@@ -38,10 +38,11 @@ from .stabilized import U1SUnl, U1SIG
 from .by_name import model_for
 from .tangents import fd_tangent
 from .history import History
+from .updated_lagrange import UpdatedLagrange
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
            "MasterIncompressible",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
-           "History"]
+           "History", "UpdatedLagrange"]

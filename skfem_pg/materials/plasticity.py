@@ -290,6 +290,13 @@ class J2Plasticity(Material):
                 RETURN_MAXITER, todo.size, todo[0], xtr[todo[0]]), todo)
 
 
+def _det33(A):
+    """Determinants of ``(n, 3, 3)`` matrices, written out."""
+    return (A[:, 0, 0] * (A[:, 1, 1] * A[:, 2, 2] - A[:, 1, 2] * A[:, 2, 1])
+            - A[:, 0, 1] * (A[:, 1, 0] * A[:, 2, 2] - A[:, 1, 2] * A[:, 2, 0])
+            + A[:, 0, 2] * (A[:, 1, 0] * A[:, 2, 1] - A[:, 1, 1] * A[:, 2, 0]))
+
+
 def _embed3(F):
     """``(n, 3, 3)`` deformation gradients from ``(d, d, n)`` (plane strain
     in 2-D: :math:`F_{33} = 1`)."""
@@ -337,52 +344,84 @@ class Response:
         self._G = F3 @ Cpn  # F C_p,n^-1
         btr = self._G @ np.swapaxes(F3, 1, 2)
         btr = 0.5 * (btr + np.swapaxes(btr, 1, 2))
-        beta, Q = np.linalg.eigh(btr)
-        if not np.all(beta > 0):
-            neg = np.flatnonzero(~np.all(beta > 0, axis=1))
+        self._btr = btr
+        # the elastic trial state without eigenvalues: bb = btr / det^(1/3)
+        # (the isochoric part), tau_dev = mu dev(bb); the spectral form
+        # of the return map is needed at the plastic points alone
+        det = _det33(btr)
+        if not np.all(det > 0):
+            neg = np.flatnonzero(~(det > 0))
             raise ReturnMapError(
                 "J2Plasticity: b_e^tr not positive definite at {} point(s) "
                 "(first {}): F inverted".format(neg.size, neg[0]), neg)
-        xtr = np.log(beta)
-        tau, T = m._tau(xtr)
-        plastic = _von_mises(tau) - m.yield_stress(alpha_n) > 0
-        x = xtr.copy()
-        dxdx = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        bb = btr / np.cbrt(det)[:, None, None]
+        tr = bb[:, 0, 0] + bb[:, 1, 1] + bb[:, 2, 2]
+        tau_full = m.mu * bb
+        for i in range(3):
+            tau_full[:, i, i] -= m.mu * tr / 3.0
+        vm = np.sqrt(1.5 * (tau_full * tau_full).sum(axis=(1, 2)))
+        plastic = vm - m.yield_stress(alpha_n) > 0
+        self._trbb = tr
         alpha = alpha_n.copy()
-        if np.any(plastic):
-            x[plastic], da, Jl, tau[plastic], T[plastic] = m.return_map(
-                xtr[plastic], alpha_n[plastic])
-            alpha[plastic] += da
-            # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
-            dxdx[plastic] = np.linalg.inv(Jl)[:, :3, :3]
-        self.plastic = plastic.reshape(self.point_shape)
+        p = np.flatnonzero(plastic)
+        self._p = p
         Finv3, J = inverse_and_det(np.moveaxis(F3, 0, -1))
-        self._Finv = np.moveaxis(Finv3, -1, 0)  # (n, 3, 3)
+        self._Finv = Finv = np.moveaxis(Finv3, -1, 0)  # (n, 3, 3)
         self.J = J
-        self._beta, self._Q, self._x = beta, Q, x
-        self._tau_dev, self._dtdx = tau, T @ dxdx  # d tau_A / d xtr_B
+        Cp_new = Cpn.copy()  # elastic points keep C_p,n^-1
+        if p.size:
+            beta, Q = np.linalg.eigh(btr[p])
+            xtr = np.log(beta)
+            x, da, Jl, tau, T = m.return_map(xtr, alpha_n[p])
+            alpha[p] += da
+            # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
+            dtdx = T @ np.linalg.inv(Jl)[:, :3, :3]
+            self._plastic_spectral = (beta, Q, x, tau, dtdx)
+            QT = np.swapaxes(Q, 1, 2)
+            tau_full[p] = (Q * tau[:, None, :]) @ QT
+            ex = np.exp(x)
+            self._trbb[p] = (ex / np.cbrt(ex.prod(axis=1))[:, None]).sum(
+                axis=1)
+            Fp = Finv[p] @ Q
+            Cp_p = (Fp * ex[:, None, :]) @ np.swapaxes(Fp, 1, 2)
+            Cp_new[p] = 0.5 * (Cp_p + np.swapaxes(Cp_p, 1, 2))
+        self.plastic = plastic.reshape(self.point_shape)
         vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
-        tau_full = np.einsum("nia,na,nma->nim", Q, tau, Q)
-        P3 = (tau_full + vol[:, None, None] * np.eye(3)) @ \
-            np.swapaxes(self._Finv, 1, 2)
+        for i in range(3):
+            tau_full[:, i, i] += vol
+        P3 = tau_full @ np.swapaxes(Finv, 1, 2)
         self._P3 = P3
         P3[bad] = np.nan
         self.P = np.moveaxis(P3[:, :d, :d], 0, 2).reshape(
             (d, d) + self.point_shape)
-        be = np.einsum("nia,na,nma->nim", Q, np.exp(x), Q)
-        Cp_new = self._Finv @ be @ np.swapaxes(self._Finv, 1, 2)
-        Cp_new = 0.5 * (Cp_new + np.swapaxes(Cp_new, 1, 2))
         self.history = {
             "Cp_inv": np.moveaxis(Cp_new, 0, 2).reshape(
                 (3, 3) + self.point_shape),
             "alpha": alpha.reshape(self.point_shape)}
         self._A = None
+        self._spectral = None
+
+    def spectral(self):
+        """``(beta, Q, tau, dtau/dxtr)`` at every point: eigenvalues and
+        vectors of the trial :math:`b_e^{tr}`, principal deviatoric
+        Kirchhoff stresses and their derivatives by the trial log
+        stretches (the return map's at the plastic points); computed on
+        demand (the tangent), not for a stress alone."""
+        if self._spectral is None:
+            m = self.material
+            beta, Q = np.linalg.eigh(self._btr)
+            tau, dtdx = m._tau(np.log(beta))
+            if self._p.size:
+                bp, Qp, _, taup, dtp = self._plastic_spectral
+                beta[self._p], Q[self._p] = bp, Qp
+                tau[self._p], dtdx[self._p] = taup, dtp
+            self._spectral = (beta, Q, tau, dtdx)
+        return self._spectral
 
     def energy(self):
         """Stored elastic energy density at the points."""
         m = self.material
-        xb = self._x - self._x.mean(axis=1, keepdims=True)
-        W = 0.5 * m.mu * (np.exp(xb).sum(axis=1) - 3)
+        W = 0.5 * m.mu * (self._trbb - 3)
         if m.K > 0:
             J = self.J
             W = W + 0.25 * m.K * (J ** 2 - 1 - 2 * np.log(J))
@@ -397,9 +436,9 @@ class Response:
 
     def _tangent(self):
         m = self.material
-        beta, Q, tau = self._beta, self._Q, self._tau_dev
+        beta, Q, tau, dtdx = self.spectral()
         n = beta.shape[0]
-        t = self._dtdx / beta[:, None, :]  # d tau_A / d beta_B
+        t = dtdx / beta[:, None, :]  # d tau_A / d beta_B
         # the spectral (shear) coefficients theta_AB, A != B
         Dp = np.zeros((n, 3, 3, 3, 3))
         for A in range(3):

@@ -44,6 +44,7 @@ from ..discretization.basis import FamilyBasis
 from ..discretization.loads import traction as pg_traction
 from ..discretization.particles import Particles
 from ..formulations.by_name import model_for
+from ..formulations.updated_lagrange import UpdatedLagrange
 from ..solvers import newton
 
 #: method -> (mesh class needed, scalar element)
@@ -304,7 +305,7 @@ class Scene:
         """What :meth:`solve` hands Newton's method: ``(basis, model,
         f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`);
         ``u_D(t)`` gives the prescribed values at load factor ``t``."""
-        from ..naming import fe_method, formulation_of, parse
+        from ..naming import fe_method, formulation_of, frame_of, parse
         method = fe_method(scheme) or scheme
         t0 = time.perf_counter()
         formulation = "Unl"
@@ -323,7 +324,11 @@ class Scene:
             mesh = self.mesh if mesh is None else mesh
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
                                 **basis_kwargs)
-            model = model_for(formulation, basis, self.material, tangent)
+            if frame_of(scheme) == "UL":
+                model = UpdatedLagrange(basis, self.material,
+                                        every=self.params.get("ul_every", 1))
+            else:
+                model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         elif method in FE_METHODS:
