@@ -49,7 +49,7 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.io import VTUSeries
+from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
                                        output_dir, save_figure,
                                        update_results)
@@ -104,23 +104,6 @@ def solved_name(label, full):
     return METHODS.get(label, (label,))[0], False
 
 
-def write_step(basis, u, ep):
-    """``write(filename)`` of one step for :class:`~skfem_pg.scenes.io.
-    VTUSeries`: the particles with u and e_p, or the FE mesh with u and
-    e_p per cell."""
-    if hasattr(basis, "particles"):
-        return lambda fn: pg.write_vtu(fn, basis.particles, u=u, ep=ep)
-
-    def write(fn):
-        import meshio
-        from skfem.io.meshio import to_meshio
-        m = to_meshio(basis.mesh, encode_cell_data=False)
-        m.point_data = {"u": u.reshape(-1, 3)}
-        m.cell_data = {"ep": [np.asarray(ep)]}
-        meshio.write(fn, m)
-    return write
-
-
 def run(sc, solved, series=None, verbose=False):
     """Solve one formulation; the curves (end displacement, force, neck
     radius, max e_p per converged step) and how it ended."""
@@ -151,7 +134,7 @@ def run(sc, solved, series=None, verbose=False):
         ep, ep_max = model.plastic_strain()
         curve["ep"].append(ep_max)
         if series is not None:
-            series.add(load * sc.elongation, write_step(basis, u, ep))
+            series.add(load * sc.elongation, step_writer(basis, u=u, ep=ep))
         if verbose:
             print("    {:.3f} mm  F {:.2f} kN  r {:.3f} mm  ep {:.3f}".format(
                 curve["disp"][-1], curve["force"][-1], curve["radius"][-1],

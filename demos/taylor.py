@@ -40,7 +40,7 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.io import VTUSeries
+from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
                                        output_dir, save_figure,
                                        update_results)
@@ -77,22 +77,6 @@ def scene(n):
     return Scene("taylor", pg.meshing.taylor_rod(n), COPPER)
 
 
-def write_step(basis, u, v, ep):
-    """``write(filename)`` of one output: particles (or the FE mesh) with
-    u, v and e_p."""
-    if hasattr(basis, "particles"):
-        return lambda fn: pg.write_vtu(fn, basis.particles, u=u, v=v, ep=ep)
-
-    def write(fn):
-        import meshio
-        from skfem.io.meshio import to_meshio
-        m = to_meshio(basis.mesh, encode_cell_data=False)
-        m.point_data = {"u": u.reshape(-1, 3), "v": v.reshape(-1, 3)}
-        m.cell_data = {"ep": [np.asarray(ep)]}
-        meshio.write(fn, m)
-    return write
-
-
 def run(sc, solved, explicit, t_end=T_END, series=None):
     """One formulation: final length, mushroom radius, max e_p, the time
     series of the length and the energies, and how it ended."""
@@ -115,8 +99,8 @@ def run(sc, solved, explicit, t_end=T_END, series=None):
         curve["kinetic"].append(rec["kinetic"])
         if series is not None:
             ep = model.plastic_strain()
-            series.add(t, write_step(basis, x[:basis.N], v,
-                                     ep[0] if ep else 0 * U[:, 0]))
+            series.add(t, step_writer(basis, u=x[:basis.N], v=v,
+                                      ep=ep[0] if ep else 0 * U[:, 0]))
 
     status = "done"
     wall = RigidWall(0, 0.0)

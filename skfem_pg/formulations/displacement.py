@@ -152,6 +152,12 @@ class Hyperelastic:
         if self.history is not None:
             self.history.commit(state["F"])
 
+    @property
+    def point_basis(self):
+        """The basis whose integration points carry the history
+        (``basis``; the current one in the updated Lagrangian frame)."""
+        return self.basis
+
     def plastic_strain(self):
         """The committed accumulated plastic strain :math:`\\bar e_p`
         (the hardening variable) per element — its weighted mean over the
@@ -161,7 +167,7 @@ class Hyperelastic:
         h = self.history
         if h is None:
             return None
-        E = Elements(self.basis)
+        E = Elements(self.point_basis)
         a = h.alpha()
         if a is None:
             a = np.zeros(E.point_shape)

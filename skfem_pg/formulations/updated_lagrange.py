@@ -41,7 +41,6 @@ import numpy as np
 
 from ..discretization.assembly import assemble
 from ..discretization.basis import FamilyBasis
-from ..discretization.elementwise import Elements
 from ..discretization.particles import Particles
 from ..threads import kernel
 from .displacement import (Hyperelastic, internal_force, material_tangent,
@@ -184,12 +183,7 @@ class UpdatedLagrange(Hyperelastic):
             A = np.einsum("iMkNpq,JMpq,LNpq->iJkLpq", A, Fc, Fc) / self.J_c
         return assemble(material_tangent, self.current, A=A)
 
-    def plastic_strain(self):
-        h = self.history
-        if h is None:
-            return None
-        E = Elements(self.current)
-        a = h.alpha()
-        if a is None:
-            a = np.zeros(E.point_shape)
-        return E.sum(a) / E.volumes, float(a.max(initial=0.0))
+    @property
+    def point_basis(self):
+        """The current basis: its points carry the history."""
+        return self.current

@@ -55,6 +55,41 @@ def _cells(particles):
     return [("vertex", np.arange(particles.n).reshape(-1, 1))]
 
 
+def step_writer(basis, **fields):
+    """``write(filename)`` of one output of a run, for
+    :class:`VTUSeries`: on a family basis the particles with ``fields``
+    (:func:`write_vtu`); on a scikit-fem basis its mesh, with dof vectors
+    (length ``basis.N``) and per-vertex arrays as point data and
+    per-element arrays as cell data."""
+    if hasattr(basis, "particles"):
+        return lambda fn: write_vtu(fn, basis.particles, **fields)
+
+    def write(fn):
+        from skfem.io.meshio import to_meshio
+        mesh = basis.mesh
+        m = to_meshio(mesh, encode_cell_data=False)
+        d = mesh.dim()
+        points, cells = {}, {}
+        for name, val in fields.items():
+            val = np.asarray(val, dtype=float)
+            if val.shape[0] == basis.N:
+                val = val.reshape(-1, d)[:mesh.nvertices]
+                points[name] = np.column_stack(
+                    [val, np.zeros((val.shape[0], 3 - d))]) if d == 2 \
+                    else val
+            elif val.shape[0] == mesh.nelements:
+                cells[name] = [val]
+            elif val.shape[0] == mesh.nvertices:
+                points[name] = val
+            else:
+                raise ValueError("field {!r} of length {}: neither dofs "
+                                 "({}), vertices nor elements".format(
+                                     name, val.shape[0], basis.N))
+        m.point_data, m.cell_data = points, cells
+        meshio.write(fn, m)
+    return write
+
+
 class VTUSeries:
     """A time series for ParaView: ``folder/step_NNN.vtu`` per step and
     the collection ``folder + ".pvd"`` that lists them with their times,

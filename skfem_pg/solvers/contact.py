@@ -84,3 +84,18 @@ class RigidWall:
         the wall must exert on each candidate dof to hold it) pushes the
         body away from the wall."""
         return self.side * force > 0
+
+
+def hold_initial(walls, candidates, u, v, a, m, held):
+    """Hold the candidates that start on a wall moving or pushed into it
+    (zero normal velocity and acceleration); returns the kinetic energy
+    the walls took."""
+    lost = 0.0
+    for w, c in zip(walls, candidates):
+        on = w.on_wall(u)
+        into = w.side * (v[c] + a[c]) < 0
+        h = c[on & into]
+        held[h] = True
+        lost += 0.5 * float(np.dot(m[h], v[h] ** 2))
+        v[h], a[h] = 0.0, 0.0
+    return lost

@@ -39,6 +39,7 @@ from scipy.sparse.linalg import eigsh
 
 from ..dofs import as_dofs
 from ..materials import ReturnMapError
+from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
                        stored_energy, time_functions)
 
@@ -165,14 +166,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     a = inv_m * (fe - fi)
     held = np.zeros(n_u, dtype=bool)  # dofs a wall holds
     energy = EnergyBalance(m, v, free, stored_energy(model, state))
-    for w, c in zip(walls, cand):  # on the wall at the start: held if
-        # moving or pushed into it
-        on = w.on_wall(u)
-        into = w.side * (v[c] + a[c]) < 0
-        h = c[on & into]
-        held[h] = True
-        energy.D_c += 0.5 * float(np.dot(m[h], v[h] ** 2))
-        v[h], a[h] = 0.0, 0.0
+    energy.D_c += hold_initial(walls, cand, u, v, a, m, held)
     hist = []
     t, steps = 0.0, 0
     progress = Progress(t_end, verbose)

@@ -31,6 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..dofs import as_dofs, check_sliding
+from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
                        stored_energy, time_functions)
 from .static import _condensed_solver, _newton_step
@@ -143,13 +144,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     fe = f_of(0.0)
     a = np.where(free, (fe[:n_u] - fi[:n_u]) / m, 0.0)
     energy = EnergyBalance(m, v, free, stored_energy(model, state))
-    for w, c in zip(walls, cand):
-        on = w.on_wall(x)
-        into = w.side * (v[c] + a[c]) < 0
-        h = c[on & into]
-        held[h] = True
-        energy.D_c += 0.5 * float(np.dot(m[h], v[h] ** 2))
-        v[h], a[h] = 0.0, 0.0
+    energy.D_c += hold_initial(walls, cand, x, v, a, m, held)
     hist = []
     t, steps, step, cuts = 0.0, 0, float(dt), 0
     progress = Progress(t_end, verbose)
