@@ -25,8 +25,11 @@ the material held elastic (:meth:`History.elastic_predictor
 <skfem_pg.formulations.history.History.elastic_predictor>`: the plastic
 tangent is softer than elastic unloading, which sets the limit),
 by Lanczos iterations (``scipy.sparse.linalg.eigsh``) on
-:math:`M^{-1/2} K M^{-1/2}`; re-estimated every ``estimate_every`` steps
-as the configuration changes.  A run whose energy balance error exceeds
+:math:`M^{-1/2} K M^{-1/2}`.  As the configuration changes the step is
+divided by :func:`compression_since` the last estimate (how much the most
+compressed point shrank since), and estimated again every
+``estimate_every`` steps or as soon as that factor exceeds
+:data:`REESTIMATE`.  A run whose energy balance error exceeds
 ``max_energy_error`` stops with :class:`DynamicsError` — the signature of
 an unstable step — instead of returning garbage.
 """
@@ -39,6 +42,7 @@ from scipy.sparse.linalg import eigsh
 
 from ..dofs import as_dofs
 from ..materials import ReturnMapError
+from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
                        stored_energy, time_functions)
@@ -49,6 +53,36 @@ from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
 #: the first steps (8 % at step 1, 0.4 % at step 10 in the wave-arrival
 #: test) and then settles; an unstable step grows without bound
 STARTUP_STEPS = 10
+
+
+#: a stable-step estimate is repeated at once when a point has been
+#: compressed by more than this factor since the last one
+REESTIMATE = 1.25
+
+
+def _gradients(state):
+    """The deformation gradients of a model's state (``F``, or the
+    masters' ``F1`` of U1SIG), or ``None``."""
+    for key in ("F", "F1"):
+        if key in state:
+            return np.array(state[key])
+    return None
+
+
+def compression_since(F_est, F):
+    r"""An upper bound of how much more any point is compressed than at
+    the last step estimate: :math:`\max_p 1 + \|F_{est} F^{-1} -
+    I\|_F` (:math:`\ge \|F_{est}F^{-1}\|_2`, the factor by which the
+    shortest material line shrank); the highest frequency of an elastic
+    body grows at most by it, so the estimated step is divided by it
+    until the next estimate."""
+    if F_est is None or F is None or F_est.shape != F.shape:
+        return 1.0
+    d = F.shape[0]
+    Fi, _ = inverse_and_det(F.reshape(d, d, -1))
+    R = np.einsum("ikp,kjp->ijp", F_est.reshape(d, d, -1), Fi)
+    R -= np.eye(d)[:, :, None]
+    return float(1.0 + np.sqrt((R * R).sum(axis=(0, 1))).max(initial=0.0))
 
 
 def _elastic(model):
@@ -182,17 +216,24 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         times["output"] += time.perf_counter() - t1
 
     step = dt
+    F_est = None  # the deformation at the last estimate
     if step is None:
         t1 = time.perf_counter()
         step = stable_time_step(model, m, u, free, safety)
+        F_est = _gradients(state)
         times["estimate"] += time.perf_counter() - t1
+    base = step  # the estimate's step, before the configuration scaling
     if output_every is None:
         output_every = max(1, int(round(t_end / step / 20)))
     output()
     while t < t_end * (1 - 1e-12):
-        if dt is None and steps and steps % estimate_every == 0:
+        if dt is None and steps:
             t1 = time.perf_counter()
-            step = stable_time_step(model, m, u, free, safety)
+            ratio = compression_since(F_est, _gradients(state))
+            if steps % estimate_every == 0 or ratio > REESTIMATE:
+                base = stable_time_step(model, m, u, free, safety)
+                F_est, ratio = _gradients(state), 1.0
+            step = base / ratio
             times["estimate"] += time.perf_counter() - t1
         h = min(step, t_end - t)
         vh = v + 0.5 * h * a
