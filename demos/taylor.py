@@ -66,7 +66,7 @@ METHODS = {
     "VCPBG U2P1C": ("VCPBG V3m U2P1C", False, (21.31, 6.70, 2.49)),
     "VCPBG Unl+P1C": ("VCPBG V5m Unl+P1C", False, (21.54, 7.28, 3.35)),
 }
-DEFAULT = ["VCPBG U1SIG", "VCPBG Unl", "FEM H1P0"]
+DEFAULT = ["VCPBG U1SIG", "FEM H1P0"]
 #: the literature's band (Table 7.6: Kamoulakis ... Cihan et al.)
 LITERATURE = {"length": (21.26, 21.66), "radius": (6.84, 7.24),
               "ep": (2.47, 4.06)}

@@ -112,3 +112,19 @@ def test_ul_by_name_and_dynamic_run_follows_tl():
             assert model.updates == tr.steps
     assert tips["TL"] < -0.05
     assert abs(tips["UL"] / tips["TL"] - 1) < 0.01
+
+
+def test_a_rebuild_on_an_inverted_mesh_stops_the_run_with_its_time():
+    """Cook's membrane hit hard (PBG UL): the collocation mesh inverts,
+    the rebuild cannot collocate particles there, and Newmark stops with
+    DynamicsError at that time (not a stray ParticleError)."""
+    from skfem_pg.solvers import DynamicsError
+    sc = pg.scenes.Scene("cook", pg.meshing.cook_membrane(4),
+                         NeoHooke(121.0, 80.8), clamped=["left"])
+    basis, model, _, D, _, _ = sc.setup("PBG Unl UL noBC")
+    f = pg.traction(basis, "right", [0.0, 1.0])
+    with pytest.raises(DynamicsError, match="could not be committed") as e:
+        newmark(model, lumped_mass(basis, 7.85), 20.0, 0.2,
+                f_ext=lambda t: 200.0 * np.sin(np.pi * t / 10.0) * f, D=D,
+                verbose=False, dt_min=0.05)
+    assert 0 < e.value.t < 20.0 and model.updates > 0

@@ -114,6 +114,22 @@ class DynamicsError(RuntimeError):
         self.history = history or []
 
 
+def commit(model, state, t, x, v, hist):
+    """``model.commit(state)`` after a step to ``t``; a model that cannot
+    go on from there (an updated-Lagrangian rebuild on an inverted
+    collocation mesh) stops the run with :class:`DynamicsError` at
+    ``t``."""
+    if not hasattr(model, "commit"):
+        return
+    from ..errors import ParticleError, FamilyError
+    try:
+        model.commit(state)
+    except (ParticleError, FamilyError) as err:
+        raise DynamicsError("the model could not be committed at t = "
+                            "{:.6g}: {}".format(t, err), t=t, x=x, v=v,
+                            history=hist) from None
+
+
 @dataclass
 class Trajectory:
     """A time integration's result: the unknowns ``x`` (displacements

@@ -45,7 +45,7 @@ from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       stored_energy, time_functions)
+                       commit, stored_energy, time_functions)
 
 
 #: steps before the energy check starts: an impulsive start (a velocity
@@ -251,8 +251,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         state = _evaluate(model, un, t + h, hist, v, u)
         fi_n = model.internal_force(state)
         t2 = time.perf_counter()
-        if hasattr(model, "commit"):
-            model.commit(state)
+        commit(model, state, t + h, u, v, hist)
         times["commit"] += time.perf_counter() - t2
         times["force"] += t2 - t1
         fe_n = f_of(t + h)

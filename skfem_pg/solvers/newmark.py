@@ -33,7 +33,7 @@ import scipy.sparse as sp
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       stored_energy, time_functions)
+                       commit, stored_energy, time_functions)
 from .static import _condensed_solver, _newton_step
 
 
@@ -184,8 +184,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
             continue
         xn, vn, an, fi_n, state, held_n, info = res
         fe_n = f_of(t + h)
-        if hasattr(model, "commit"):
-            model.commit(state)
+        commit(model, state, t + h, x, v, hist)
         touched = np.flatnonzero(held | held_n)
         energy.step(xn - x, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
                     free & ~held, free & ~held_n)
