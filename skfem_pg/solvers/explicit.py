@@ -147,7 +147,9 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         Initial displacements and velocities (default zero).
     dt
         Fixed step; default ``safety · 2/ω_max`` (:func:`stable_time_step`),
-        re-estimated every ``estimate_every`` steps.
+        scaled down as points are compressed (:func:`compression_since`)
+        and estimated again every ``estimate_every`` steps or when that
+        scaling passes :data:`REESTIMATE`.
     wall
         A :class:`~skfem_pg.solvers.RigidWall` (or a list of them).
     callback
