@@ -108,8 +108,9 @@ class UpdatedLagrange(Hyperelastic):
     # -- the update ----------------------------------------------------
     def rebuild(self, u, F=None):
         """Rebuild the basis at the configuration ``X + u`` with ``F``
-        (flat points of the current basis; default: the committed one)
-        becoming :math:`F_c`; the history follows the points."""
+        (flat points of the current basis; default: the deformation
+        gradient at ``u``) becoming :math:`F_c`; the committed history
+        follows the points."""
         p0 = self.basis.particles
         mesh = p0.mesh
         d = p0.dim
@@ -117,18 +118,17 @@ class UpdatedLagrange(Hyperelastic):
         moved = type(mesh)(x, mesh.t)
         particles = Particles.from_mesh(moved, elements=p0.elements)
         new = FamilyBasis(particles, **self.basis.options)
-        F = self._F_committed if F is None else F
+        F = self.state(u)["F"] if F is None else F
         h = self.history
-        arrays = [F.reshape(d * d, -1)] if F is not None else []
+        arrays = [F.reshape(d * d, -1)]
         if h is not None and h.committed is not None:
             names = sorted(h.committed)
             arrays += [h.committed[k].reshape(-1, h.committed[k].shape[-1])
                        for k in names]
         arrays = remap_points(self.current, new, arrays)
-        if F is not None:
-            Fn = arrays[0].reshape(d, d, 1, -1)
-            self.F_c, self.J_c = Fn, _det(Fn)
-            arrays = arrays[1:]
+        Fn = arrays[0].reshape(d, d, 1, -1)
+        self.F_c, self.J_c = Fn, _det(Fn)
+        arrays = arrays[1:]
         if h is not None and h.committed is not None:
             shapes = {k: h.committed[k].shape for k in names}
             h.committed = {k: a.reshape(shapes[k][:-1] + (-1,))
@@ -143,12 +143,9 @@ class UpdatedLagrange(Hyperelastic):
         """Commit the step (history, :math:`F`) and rebuild every
         ``every`` commits."""
         super().commit(state)
-        self._F_committed = np.array(state["F"])
         self._commits += 1
         if self._commits % self.every == 0:
-            self.rebuild(state["u"])
-
-    _F_committed = None
+            self.rebuild(state["u"], np.array(state["F"]))
 
     # -- the model -----------------------------------------------------
     @kernel
