@@ -74,6 +74,15 @@ def _dim(basis):
 
 
 def _det(F):
+    """``det F`` of ``(d, d, ...)`` arrays, written out for d = 2, 3 (no
+    batched LAPACK call: an explicit step checks every point's J)."""
+    d = F.shape[0]
+    if d == 2:
+        return F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]
+    if d == 3:
+        return (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
+                - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
+                + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
     return np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
 
 
