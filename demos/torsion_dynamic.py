@@ -105,7 +105,7 @@ def run(mesh, solved, max_angle, vtu=None):
     try:
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             tr = newmark(model, m, t_end, dt, D=D, u_D=u_D, callback=output,
-                         dt_min=0.1 / 360 * TURN, verbose=False,
+                         dt_min=0.1 / 360 * TURN, verbose=True,
                          maxiter=15)
         steps = tr.steps
     except DynamicsError:
