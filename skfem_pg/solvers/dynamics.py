@@ -169,7 +169,7 @@ class Progress:
             self.next += 1
         wall = time.perf_counter() - self.t0
         e = energies
-        print("  t {:.4g} ({:3.0f} %)  dt {:.3g}  {} steps, {:.0f}/s  "
+        print("  t {:.4g} ({:3.0f} %)  dt {:.3g}  {} steps, {:.3g}/s  "
               "T {:.4g}  W_int {:.4g}  W_ext {:.4g}  D_c {:.3g}  "
               "energy error {:.2e}".format(
                   t, 100 * frac, dt, steps, steps / max(wall, 1e-9),
