@@ -36,8 +36,8 @@ from skfem_pg.materials import NeoHooke
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+                                       new_figure, output_dir,
+                                       save_figure, update_results)
 from skfem_pg.solvers import DynamicsError, lumped_mass, newmark
 
 E, NU, RHO = 210.0, 0.3, 7.85
@@ -148,10 +148,7 @@ def main(n=16, steps=500, variants=None, results=None, out=None, q0=Q0):
 
 
 def plot(runs, fn):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = new_figure()
     for (v, frame), r in runs.items():
         c = r["curve"]
         ax.plot(c["t"] / 1000, c["tip"], "-" if frame == "TL" else "--",
@@ -159,7 +156,6 @@ def plot(runs, fn):
     ax.set_xlabel("t [ms]")
     ax.set_ylabel("tip displacement u_y [mm]")
     ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
     save_figure(fig, fn)
 
 

@@ -51,8 +51,8 @@ from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+                                       new_figure, output_dir,
+                                       save_figure, update_results)
 from skfem_pg.solvers import ConvergenceError, newton
 
 STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,
@@ -250,10 +250,7 @@ def main(n=1, overkill=3, methods=None, results=None, out=None,
 
 
 def plot(rows, fn):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, (a1, a2) = new_figure(2, figsize=(12, 4.5))
     for label, r in rows.items():
         c = r["curve"]
         if c is None:
@@ -266,7 +263,6 @@ def plot(rows, fn):
     a2.set_xlabel("end displacement [mm]")
     a2.set_ylabel("radius at the neck [mm]")
     a1.legend(fontsize=7)
-    fig.tight_layout()
     save_figure(fig, fn)
 
 

@@ -42,8 +42,8 @@ from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+                                       new_figure, output_dir,
+                                       save_figure, update_results)
 from skfem_pg.solvers import (DynamicsError, RigidWall, central_difference,
                               lumped_mass, newmark)
 
@@ -202,10 +202,7 @@ def main(n=1, methods=None, results=None, out=None, t_end=T_END):
 
 
 def plot(rows, fn):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    fig, (a1, a2) = new_figure(2, figsize=(12, 4.5))
     for label, r in rows.items():
         c = r["curve"]
         a1.plot(c["t"], c["length"], label=label)
@@ -216,7 +213,6 @@ def plot(rows, fn):
     a2.set_xlabel("t [µs]")
     a2.set_ylabel("kinetic energy [J]")
     a1.legend(fontsize=7)
-    fig.tight_layout()
     save_figure(fig, fn)
 
 

@@ -36,8 +36,8 @@ from skfem_pg.discretization.particles import inverted_cells
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+                                       new_figure, output_dir,
+                                       save_figure, update_results)
 from skfem_pg.solvers import DynamicsError, lumped_mass, newmark
 
 STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,
@@ -186,10 +186,7 @@ def main(n=3, methods=None, max_angle=720.0, results=None, out=None):
 
 
 def plot(runs, fn):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(8, 4.5))
+    fig, ax = new_figure()
     for label, (r1, r2) in runs.items():
         line, = ax.plot(r1["curve"]["angle"], r1["curve"]["ep"],
                         label=label + " D1")
@@ -198,7 +195,6 @@ def plot(runs, fn):
     ax.set_xlabel("twist [deg]")
     ax.set_ylabel("max e_p")
     ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
     save_figure(fig, fn)
 
 

@@ -122,6 +122,16 @@ def save_error_vs_time(fn, rows, styles, ylabel, title, target=0.01):
     plt.close(fig)
 
 
+def new_figure(ncols=1, figsize=(8, 4.5)):
+    """``(fig, axes)`` of ``ncols`` side-by-side plots on matplotlib's
+    file backend (demos write PNGs; no display needed); write it with
+    :func:`save_figure`."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt.subplots(1, ncols, figsize=figsize)
+
+
 def save_figure(fig, fn, dpi=120):
     """Tight layout, write ``fn`` (creating its folder), close, say so."""
     import matplotlib.pyplot as plt

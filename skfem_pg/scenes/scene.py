@@ -304,7 +304,10 @@ class Scene:
               **basis_kwargs):
         """What :meth:`solve` hands Newton's method: ``(basis, model,
         f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`);
-        ``u_D(t)`` gives the prescribed values at load factor ``t``."""
+        ``u_D(t)`` gives the prescribed values at load factor ``t``.  A
+        name in the updated Lagrangian frame (``"... Unl UL"``) gives an
+        :class:`~skfem_pg.formulations.UpdatedLagrange` model, rebuilt
+        every ``params["ul_every"]`` converged steps (default 1)."""
         from ..naming import fe_method, formulation_of, frame_of, parse
         method = fe_method(scheme) or scheme
         t0 = time.perf_counter()

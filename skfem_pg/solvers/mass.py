@@ -80,7 +80,3 @@ def _per(rho, n, what):
             rho[~(rho > 0)][0], what, np.flatnonzero(~(rho > 0))[0]))
     return rho
 
-
-def kinetic_energy(m, v):
-    """:math:`\\tfrac12 v \\cdot M v` for the diagonal mass ``m``."""
-    return 0.5 * float(np.dot(m, v * v))
