@@ -62,10 +62,11 @@ REESTIMATE = 1.25
 
 def _gradients(state):
     """The deformation gradients of a model's state (``F``, or the
-    masters' ``F1`` of U1SIG), or ``None``."""
+    masters' ``F1`` of U1SIG), or ``None`` (a view: a new state holds
+    new arrays, so the one kept at an estimate stays as it was)."""
     for key in ("F", "F1"):
         if key in state:
-            return np.array(state[key])
+            return state[key]
     return None
 
 
