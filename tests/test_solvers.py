@@ -264,3 +264,49 @@ def test_amg_on_sliding_boundaries_and_the_step_callback():
                           B[free])
     with pytest.raises(ValueError, match="components"):
         rigid_body_modes(locs[:, free[:-1]])
+
+
+class _Arctan:
+    """r(x) = arctan(x) per unknown: Newton from |x| > 1.39 oscillates
+    with growing amplitude (the classic counterexample)."""
+
+    def __init__(self, max_x=np.inf):
+        self.max_x = max_x
+
+    def state(self, x):
+        return x.copy()
+
+    def min_J(self, x):  # an 'inverted' iterate beyond max_x
+        return 1.0 if np.abs(x).max() < self.max_x else -1.0
+
+    def internal_force(self, x):
+        return np.arctan(x)
+
+    def tangent(self, x):
+        import scipy.sparse as sp
+        return sp.diags(1.0 / (1.0 + x * x))
+
+
+@pytest.mark.parametrize("max_x", [np.inf, 2.0])
+def test_line_search_tames_an_oscillating_newton(max_x):
+    """Without the line search the iterates 1.5, -1.69, 2.32, ... diverge
+    (or, beyond max_x, fail as J <= 0); halving the increment that raises
+    the residual (or fails) converges to the root."""
+    from scipy.sparse.linalg import spsolve
+    from skfem_pg.solvers.static import _newton_step
+    model = _Arctan(max_x)
+    x0 = np.array([1.5, 0.3])
+    none = np.array([], dtype=int)
+
+    def step(line_search):
+        return _newton_step(model, x0, 0.0, np.zeros(2), none, np.zeros(0),
+                            np.arange(2), spsolve, 1e-10, 25, line_search)
+
+    ok, x, info, _ = step(False)
+    assert not ok
+    assert info["reason"] == ("diverging" if max_x == np.inf else "J <= 0")
+    ok, x, info, _ = step(True)
+    assert ok and np.abs(x).max() < 1e-10
+    assert info["backtracks"] >= 1
+    r = info["residuals"]
+    assert all(b <= a for a, b in zip(r[1:], r[2:]))  # after the first

@@ -77,7 +77,8 @@ class _Inertial:
 def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
             v0=None, beta=0.25, gamma=0.5, dt_min=None, tol=1e-8,
             maxiter=20, solver="auto", wall=None, callback=None,
-            output_every=1, verbose=True, max_contact_passes=20):
+            output_every=1, verbose=True, max_contact_passes=20,
+            line_search=False):
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by Newmark's method (module docstring).
 
@@ -95,7 +96,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         callables of the time; ``D`` the prescribed dofs.
     u0, v0
         Initial displacements (or all unknowns) and velocities.
-    tol, maxiter, solver
+    tol, maxiter, solver, line_search
         Newton's method per step (:func:`~skfem_pg.solvers.newton`).
     wall
         A :class:`~skfem_pg.solvers.RigidWall` (or a list): an active set
@@ -168,7 +169,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         h = min(step, t_end - t)
         ok, res = _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of,
                         walls, cand, beta, gamma, tol, maxiter, solver,
-                        solvers, times, max_contact_passes)
+                        solvers, times, max_contact_passes, line_search)
         if not ok:
             cuts += 1
             step = h / 2
@@ -202,7 +203,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
 
 def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
           cand, beta, gamma, tol, maxiter, solver, solvers, times,
-          max_passes):
+          max_passes, line_search=False):
     """One Newmark step from ``t`` to ``t + h``, repeated while the wall's
     active set changes: ``(True, (x, v, a, f_int, state, held, info))``
     or ``(False, reason)``."""
@@ -231,7 +232,7 @@ def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
         inert = _Inertial(model, mm, c, u_tilde)
         ok, xn, info, state = _newton_step(inert, start, 1.0, f_of(t + h),
                                            C, values[C], I, solvers[key],
-                                           tol, maxiter)
+                                           tol, maxiter, line_search)
         times["assemble"] += info["t_assemble"]
         times["linear"] += info["t_linear"]
         if not ok:
