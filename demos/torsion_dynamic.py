@@ -14,7 +14,10 @@ failure, regrown after easy steps; D2 stops where a step of 0.1 degree
 (``dt_min``) does not converge, and that angle is the failure angle
 (``--max-angle`` caps the run).  Beside each failure, the inversion
 diagnostic: how many collocation cells the last converged state turns
-inside out (``particles.inverted_cells``).
+inside out (``particles.inverted_cells``).  Newton takes full increments
+(a failed iterate cuts the step), as the thesis' failure angles assume;
+``--line-search`` halves an increment that fails or raises the residual
+first (:func:`skfem_pg.solvers.newton`).
 
 Prints per formulation: max e_p at 360 degrees (D1) and the failure angle
 (D2) beside Table 7.5, steps and wall time; writes out/torsion_dynamic.png
@@ -22,7 +25,7 @@ Prints per formulation: max e_p at 360 degrees (D1) and the failure angle
 formulation.  ``--results benchmarks/README.md`` writes the table there.
 
     python demos/torsion_dynamic.py [--n 3] [--methods ...] [--full]
-                                    [--max-angle 720]
+                                    [--max-angle 720] [--line-search]
 """
 import math
 import os
@@ -83,7 +86,7 @@ def twist(x, t):
     return np.array([c * X - s * Y - X, s * X + c * Y - Y, 0.0 * x[2]])
 
 
-def run(mesh, solved, max_angle, vtu=None):
+def run(mesh, solved, max_angle, vtu=None, line_search=False):
     """Twist to ``max_angle`` degrees (or failure): the angle reached, the
     max e_p over the angle, the inversion diagnostic."""
     t0 = time.perf_counter()
@@ -106,7 +109,7 @@ def run(mesh, solved, max_angle, vtu=None):
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             tr = newmark(model, m, t_end, dt, D=D, u_D=u_D, callback=output,
                          dt_min=0.1 / 360 * TURN, verbose=True,
-                         maxiter=15)
+                         maxiter=15, line_search=line_search)
         steps = tr.steps
     except DynamicsError:
         status = "failed"
@@ -140,7 +143,8 @@ def ep_at(curve, angle):
         else None
 
 
-def main(n=3, methods=None, max_angle=720.0, results=None, out=None):
+def main(n=3, methods=None, max_angle=720.0, results=None, out=None,
+         line_search=False):
     out = output_dir(out)
     print(pg.threads.describe())
     d1, d2 = prism(n, 0.25), prism(n, 0.5)
@@ -153,12 +157,13 @@ def main(n=3, methods=None, max_angle=720.0, results=None, out=None):
         print("  {} ...".format(label), flush=True)
         r1 = run(d1, solved, 360.0, os.path.join(
             out, "torsion_dynamic_{}.vtu".format(
-                solved.replace(" ", "_").replace("+", "p"))))
+                solved.replace(" ", "_").replace("+", "p"))),
+            line_search)
         ep1 = ep_at(r1["curve"], 360.0)
         print("    D1: {} at {:.1f} deg, max e_p at 360: {}, {} steps, "
               "{:.0f} s".format(r1["status"], r1["angle"], ep1, r1["steps"],
                                 r1["seconds"]), flush=True)
-        r2 = run(d2, solved, max_angle)
+        r2 = run(d2, solved, max_angle, line_search=line_search)
         print("    D2: {} at {:.1f} deg ({} inverted cells), {} steps, "
               "{:.0f} s".format(r2["status"], r2["angle"], r2["inverted"],
                                 r2["steps"], r2["seconds"]), flush=True)
@@ -177,10 +182,12 @@ def main(n=3, methods=None, max_angle=720.0, results=None, out=None):
     print(text)
     if results:
         print("updated", update_results(
-            results, "torsion_dynamic_{}_{:g}".format(n, max_angle),
-            "`python demos/torsion_dynamic.py --n {} --max-angle {:g}`: {} "
-            "x {} x {} hexahedra ({} nodes).\n\n".format(
-                n, max_angle, n, n, 5 * n, d1.nvertices) + text))
+            results, "torsion_dynamic_{}_{:g}{}".format(
+                n, max_angle, "_ls" if line_search else ""),
+            "`python demos/torsion_dynamic.py --n {} --max-angle {:g}{}`: "
+            "{} x {} x {} hexahedra ({} nodes).\n\n".format(
+                n, max_angle, " --line-search" if line_search else "", n, n,
+                5 * n, d1.nvertices) + text))
     plot(runs, os.path.join(out, "torsion_dynamic.png"))
     return runs
 
@@ -209,7 +216,11 @@ if __name__ == "__main__":
                     metavar="METHOD")
     ap.add_argument("--max-angle", type=float, default=720.0,
                     help="where D2 stops if nothing fails (default 720)")
+    ap.add_argument("--line-search", action="store_true",
+                    help="Newton with its line search (default: full "
+                    "increments, as the thesis' failure angles assume)")
     a = ap.parse_args()
     main(7 if a.full else a.n,
          list(METHODS) if a.full and not a.methods else a.methods,
-         a.max_angle if not a.full else 2400.0, a.results, a.out)
+         a.max_angle if not a.full else 2400.0, a.results, a.out,
+         a.line_search)
