@@ -8,9 +8,10 @@ Load stepping: the load factor :math:`\lambda` goes from 0 to 1 (external
 forces and prescribed displacements are scaled).  A converged step is
 committed (``model.commit``: the internal variables of a plastic
 material); a failed one is not, so the history after it is the last
-converged one.  A step is cut in half when Newton diverges, exceeds ``maxiter`` or meets :math:`J \le 0` anywhere; a
-:class:`ConvergenceError` names the load factor once the step would fall
-below ``min_step``.
+converged one.  A step is cut in half when Newton diverges, exceeds
+``maxiter`` or meets :math:`J \le 0` anywhere (with ``line_search``, after
+halving the increment); a :class:`ConvergenceError` names the load factor
+once the step would fall below ``min_step``.
 """
 import time
 
