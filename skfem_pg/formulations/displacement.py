@@ -34,6 +34,7 @@ from skfem.helpers import ddot, grad
 
 from ..discretization.assembly import assemble
 from ..discretization.elementwise import Elements
+from ..materials.hyperelastic import det
 from ..threads import kernel
 from .history import History
 from .tangents import fd_tangent
@@ -71,19 +72,6 @@ material_tangent.coefficients = _tangent_coefficients
 def _dim(basis):
     return basis.particles.dim if hasattr(basis, "particles") else \
         basis.mesh.dim()
-
-
-def _det(F):
-    """``det F`` of ``(d, d, ...)`` arrays, written out for d = 2, 3 (no
-    batched LAPACK call: an explicit step checks every point's J)."""
-    d = F.shape[0]
-    if d == 2:
-        return F[0, 0] * F[1, 1] - F[0, 1] * F[1, 0]
-    if d == 3:
-        return (F[0, 0] * (F[1, 1] * F[2, 2] - F[1, 2] * F[2, 1])
-                - F[0, 1] * (F[1, 0] * F[2, 2] - F[1, 2] * F[2, 0])
-                + F[0, 2] * (F[1, 0] * F[2, 1] - F[1, 1] * F[2, 0]))
-    return np.linalg.det(np.moveaxis(F, (0, 1), (-2, -1)))
 
 
 class Hyperelastic:
@@ -200,7 +188,7 @@ class Hyperelastic:
         return float(np.sum(dx * self.material.energy(state["F"])))
 
     def min_J(self, state):
-        return float(_det(state["F"]).min())
+        return float(det(state["F"]).min())
 
     @kernel
     def stress(self, state):

@@ -66,7 +66,7 @@ from ..discretization.elementwise import Elements
 from ..discretization.shape.least_squares import mls1_master_hessians
 from ..materials.frozen import FrozenPlasticity
 from ..materials.hyperelastic import NeoHookeIsoVol, StVenantKirchhoff, \
-    NeoHooke, LinearElastic
+    NeoHooke, LinearElastic, det
 from ..materials.plasticity import J2Plasticity
 from ..threads import kernel
 from .displacement import Hyperelastic, internal_force, material_tangent
@@ -218,8 +218,7 @@ class _MasterModel(Hyperelastic):
         return {"u": u, "F1": self.master_F(u)}
 
     def min_J(self, state):
-        return float(np.linalg.det(np.moveaxis(state["F1"], (0, 1),
-                                               (-2, -1))).min())
+        return float(det(state["F1"]).min())
 
     def commit(self, state):
         """A step converged: commit the master history and the state the
@@ -299,8 +298,7 @@ class U1SUnl(_MasterModel):
         return s
 
     def min_J(self, state):
-        return min(super().min_J(state), float(np.min(np.linalg.det(
-            np.moveaxis(state["F"], (0, 1), (-2, -1))))))
+        return min(super().min_J(state), float(det(state["F"]).min()))
 
     def energy(self, state):
         Wm, Wj = self._stabilization()

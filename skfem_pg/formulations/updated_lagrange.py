@@ -43,8 +43,8 @@ from ..discretization.assembly import assemble
 from ..discretization.basis import FamilyBasis
 from ..discretization.particles import Particles
 from ..threads import kernel
-from .displacement import (Hyperelastic, internal_force, material_tangent,
-                           _det)
+from ..materials.hyperelastic import det
+from .displacement import Hyperelastic, internal_force, material_tangent
 
 
 def _point_keys(basis):
@@ -127,7 +127,7 @@ class UpdatedLagrange(Hyperelastic):
                        for k in names]
         arrays = remap_points(self.current, new, arrays)
         Fn = arrays[0].reshape(d, d, 1, -1)
-        self.F_c, self.J_c = Fn, _det(Fn)
+        self.F_c, self.J_c = Fn, det(Fn)
         arrays = arrays[1:]
         if h is not None and h.committed is not None:
             shapes = {k: h.committed[k].shape for k in names}

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import FamilyError, ParticleError
 from .static import _padded
 
 
@@ -121,7 +122,6 @@ def commit(model, state, t, x, v, hist):
     ``t``."""
     if not hasattr(model, "commit"):
         return
-    from ..errors import ParticleError, FamilyError
     try:
         model.commit(state)
     except (ParticleError, FamilyError) as err:
