@@ -44,7 +44,7 @@ from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
 from . import families as families_mod
-from . import petrov
+from . import corrections, petrov
 from .corrections import (bond_correction, check_correction,
                           correction_functions, family_radii, vc_correction)
 from ..dofs import as_dofs
@@ -157,6 +157,13 @@ class FamilyBasis(AbstractBasis):
         basis raises :class:`~skfem_pg.errors.CorrectionError` naming the worst
         particles.  ``None`` keeps an inexact correction with a warning
         (studies of the incompatible V2/V4/VC2 systems).
+    vc_correction
+        The function that corrects the derivatives of the unpadded PBG
+        path (default
+        :func:`~skfem_pg.discretization.corrections.vc_correction`); a
+        rank's part of a distributed basis gets
+        :meth:`skfem_pg.distributed.Partition.vc_correction`, which
+        solves the constraint system of all ranks' families.
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
         basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
@@ -197,7 +204,7 @@ class FamilyBasis(AbstractBasis):
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
                  test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
-                 vc_tolerance=1e-8):
+                 vc_tolerance=1e-8, vc_correction=vc_correction):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -259,6 +266,7 @@ class FamilyBasis(AbstractBasis):
             vc_exclude=vc_exclude, test_shape=test_shape, lme_mu=lme_mu,
             vc_boundary=vc_boundary, vc_tolerance=vc_tolerance)
         self.test_shape = test_shape
+        self._vc_correction = vc_correction
         self.weight_exponent = weight_exponent
         self.timings = {}
         x, V = particles.x, particles.volumes
@@ -289,6 +297,10 @@ class FamilyBasis(AbstractBasis):
                     and vc in (None, "V3", "V5") and vc_exclude is None
                     and vc_boundary in ("min-norm", "p"))
         self._G = self._G_groups = None
+        if not unpadded and vc_correction is not corrections.vc_correction:
+            raise NotImplementedError(
+                "a custom vc_correction (a distributed basis) is taken by "
+                "the unpadded PBG path only (MTE1/WTE1, vc V3/V5/None)")
         if unpadded:  # the default: each size group without padding
             self._unpadded_pipeline(vc_solver, area_vectors, vc_tolerance)
         else:
@@ -471,7 +483,7 @@ class FamilyBasis(AbstractBasis):
             area = self._area_vectors(area_vectors)
             phis = [correction_functions(self.vc, x, V, f, n=n)
                     for f in subs]
-            Gs, self.vc_report = vc_correction(
+            Gs, self.vc_report = self._vc_correction(
                 Gs, dxs, x, V, subs, area, phis, variant=self.vc,
                 solver=vc_solver, boundary=self.vc_boundary,
                 surface=(p.surface_area_vectors() if p.mesh is not None

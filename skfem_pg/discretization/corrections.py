@@ -347,6 +347,63 @@ def _solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
     return alpha - Z @ coef, its, used
 
 
+def vc_parts(G, dx, fam, phi, index, x, variant):
+    """The pieces of :func:`vc_correction` (its arguments) per part — one
+    part per size group (list arguments) or one in all: ``parts`` of
+    ``(G, dx, fam, phi, index)``, the ``(nf,)`` masters, the ``(nf, d,
+    d)`` matrices :math:`B^k = \\sum_j w_{kj} Q^{kj}` and the projectors
+    :math:`Q^{kj}` per part (the bond projectors for V5, else ``I``)."""
+    if isinstance(G, (list, tuple)):
+        nf = sum(len(f) for f in fam)
+        parts = list(zip(G, dx, fam, phi, index))
+    else:
+        nf = len(fam)
+        parts = [(G, dx, fam, phi, None)]
+    d = x.shape[0]
+    masters = np.empty(nf, dtype=np.int64)
+    Qs, B = [], np.empty((nf, d, d))
+    for Gp, dxp, f, _, idx in parts:
+        at = slice(None) if idx is None else idx
+        masters[at] = f.masters
+        mem = f.padded()[0]
+        if variant == "V5":
+            Q = bond_projectors(x, f)
+        else:
+            Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
+        nfp, m = mem.shape
+        B[at] = (dxp[:, None, :] @ np.reshape(Q, (nfp, m, d * d))).reshape(
+            nfp, d, d)
+        Qs.append(Q)
+    return parts, masters, B, Qs
+
+
+def vc_residual(parts, Gl, n):
+    """``(n, d)`` sum over the parts' families of
+    :math:`\\sum_{kj} w_{kj} G^{kji}` per particle ``i`` (the constraint
+    residual without the area vectors), ``Gl`` the derivatives per
+    part."""
+    d = parts[0][0].shape[-1]
+    return sum(constraint_residual(Gp, p[1], p[2], np.zeros((d, n)))
+               for Gp, p in zip(Gl, parts))
+
+
+def vc_apply(parts, Qs, alpha):
+    r"""The corrected derivatives per part, :math:`G^{kji} + \varphi^{ki}
+    Q^{kj}\alpha^k` (V2: :math:`\varphi^{ki}\alpha^k` at every member),
+    ``alpha`` of shape ``(nf, d)``."""
+    Gc = []
+    for (Gp, _, f, ph, idx), Q in zip(parts, Qs):
+        mask = f.padded()[1]
+        al = alpha if idx is None else alpha[idx]
+        if ph.ndim == 4:  # V2: C^{kji} = phi^{ki} alpha^k, every member j
+            Ha = (ph @ al[:, None, :, None])[..., 0]  # (nf, m_i, d)
+            Gc.append(Gp + mask[:, :, None, None] * Ha[:, None, :, :])
+        else:
+            Qa = (Q @ al[:, None, :, None])[..., 0] * mask[..., None]
+            Gc.append(Gp + ph[:, None, :, None] * Qa[:, :, None, :])
+    return Gc
+
+
 def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                   solver="auto", tol=1e-14, maxiter=None, exclude=None,
                   boundary="min-norm", surface=None, index=None):
@@ -440,36 +497,16 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                          "modes of V3/V5; {} has others: use 's' or 'sn'"
                          .format(variant))
     grouped = isinstance(G, (list, tuple))
-    if grouped:  # one part per size group: (G, dx, fam, phi, index)
-        nf = sum(len(f) for f in fam)
-        parts = list(zip(G, dx, fam, phi, index))
-    else:
-        nf = len(fam)
-        parts = [(G, dx, fam, phi, None)]
+    parts, masters, B, Qs = vc_parts(G, dx, fam, phi, index, x, variant)
+    nf = len(masters)
     d, n = x.shape
-    masters = np.empty(nf, dtype=np.int64)
-    for _, _, f, _, idx in parts:
-        masters[slice(None) if idx is None else idx] = f.masters
     active = volumes > 0
     h = np.mean(volumes[active]) ** (1.0 / d)
     area_scale = h ** (d - 1)
     t0 = time.perf_counter()
-    Qs, B = [], np.empty((nf, d, d))
-    for Gp, dxp, f, _, idx in parts:
-        mem = f.padded()[0]
-        if variant == "V5":
-            Q = bond_projectors(x, f)
-        else:
-            Q = np.broadcast_to(np.eye(d), mem.shape + (d, d))
-        nfp, m = mem.shape
-        B[slice(None) if idx is None else idx] = (
-            dxp[:, None, :] @ np.reshape(Q, (nfp, m, d * d))).reshape(
-                nfp, d, d)
-        Qs.append(Q)
 
     def residual(Gl):
-        return sum(constraint_residual(Gp, p[1], p[2], 0 * area)
-                   for Gp, p in zip(Gl, parts)) - area.T
+        return vc_residual(parts, Gl, n) - area.T
 
     def matrix(scalar=False):
         out = 0
@@ -543,17 +580,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     else:
         raise ValueError("unknown VC solver {!r}: use 'direct', 'amg', "
                          "'lsqr' or 'auto'".format(solver))
-    alpha = alpha.reshape(-1, d)
-    Gc = []
-    for (Gp, _, f, ph, idx), Q in zip(parts, Qs):
-        mask = f.padded()[1]
-        al = alpha if idx is None else alpha[idx]
-        if ph.ndim == 4:  # V2: C^{kji} = phi^{ki} alpha^k, every member j
-            Ha = (ph @ al[:, None, :, None])[..., 0]  # (nf, m_i, d)
-            Gc.append(Gp + mask[:, :, None, None] * Ha[:, None, :, :])
-        else:
-            Qa = (Q @ al[:, None, :, None])[..., 0] * mask[..., None]
-            Gc.append(Gp + ph[:, None, :, None] * Qa[:, :, None, :])
+    Gc = vc_apply(parts, Qs, alpha.reshape(-1, d))
     r1 = residual(Gc)
     if not grouped:
         Gc = Gc[0]

@@ -1,0 +1,24 @@
+"""PG on PETSc/MPI: each rank builds and assembles the families of the
+particles it owns; PETSc sums the ranks' parts and solves.
+
+=================  =====================================================
+``partition``      :class:`Partition`: METIS split of the particles, the
+                   rank's families and local basis (owned + halo
+                   particles), numbering, the VC correction over ranks
+``petsc``          local matrices/vectors into distributed PETSc ones
+                   (scikit-fem's MATIS route), KSP with GAMG and the
+                   rigid-body near-null space, options strings
+``solve``          linear solve and Newton's method on PETSc
+``comm``           the optional MPI stack (mpi4py, petsc4py, pymetis)
+=================  =====================================================
+
+Run a script on two ranks with ``mpirun -n 2 python script.py``; see
+``demos/cube_mpi.py`` and the README's "MPI" section.
+"""
+from .comm import as_mpi
+from .partition import Partition, metis_parts
+from .solve import solve, newton
+from . import petsc
+
+__all__ = ["Partition", "metis_parts", "solve", "newton", "petsc",
+           "as_mpi"]

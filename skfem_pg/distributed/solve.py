@@ -1,0 +1,175 @@
+r"""Linear and Newton solves of distributed models on PETSc.
+
+Inputs that describe the whole problem — external forces, prescribed dofs
+and values — are given as in serial runs, in scikit-fem's serial numbering
+and the same on every rank (they come from the replicated mesh, e.g.
+``pg.traction`` on a serial FE basis).  Each rank assembles its families
+on its local basis; :mod:`~skfem_pg.distributed.petsc` sums the ranks'
+parts into one PETSc matrix and vector.  Results come back in the serial
+numbering on every rank (:meth:`Partition.gather`), so output and
+post-processing are the serial ones.
+
+Dirichlet conditions are PETSc's ``MatZeroRowsColumns``: the rows and
+columns of the prescribed dofs are replaced by the identity and the
+prescribed values lifted to the right-hand side (the serial solver's
+``K_II u_I = f_I - K_ID u_D``).
+"""
+import time
+
+import numpy as np
+
+from . import petsc as pt
+from .comm import mpi
+from ..solvers.static import ConvergenceError
+
+
+def _dirichlet(part, D, u_D):
+    """``(rows, values)``: the owned PETSc rows of the serial dofs ``D``
+    and the values of ``u_D`` (serial vector or None) there."""
+    D = np.unique(np.asarray([] if D is None else D, dtype=np.int64))
+    if len(D) and (D.min() < 0 or D.max() >= part.N):
+        raise ValueError("Dirichlet dofs must lie in 0..{}".format(
+            part.N - 1))
+    mine = D[part.owner[D // part.ncomp] == part.rank]
+    rows = part.serial_to_petsc(mine)
+    if u_D is None:
+        return rows, np.zeros(len(rows))
+    u_D = np.asarray(u_D, dtype=float)
+    if u_D.shape != (part.N,):
+        raise ValueError("u_D is a serial vector of {} entries, got shape "
+                         "{}".format(part.N, u_D.shape))
+    return rows, u_D[mine]
+
+
+def _lifted(K, rhs, rows, values, part):
+    """``K`` and ``rhs`` with the identity at ``rows``, ``values`` lifted
+    (in place; returns the vector of prescribed values)."""
+    x = pt.empty_vector(part)
+    if len(rows):
+        x.setValues(rows, values)
+    x.assemble()
+    K.zeroRowsColumns(rows, diag=1.0, x=x, b=rhs)
+    return x
+
+
+def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True):
+    """Solve the linear system whose rank-local parts are ``K`` (scipy
+    sparse, local dofs of ``part``'s basis) with the serial load ``f``
+    and Dirichlet dofs ``D`` (values ``u_D``, serial vectors).
+
+    Returns ``(u, info)``: ``u`` in the serial numbering on every rank,
+    ``info`` with the KSP iterations and seconds for assembly and solve.
+    """
+    t0 = time.perf_counter()
+    A = pt.matrix(K, part)
+    b = pt.from_serial(np.zeros(part.N) if f is None else f, part)
+    rows, values = _dirichlet(part, D, u_D)
+    _lifted(A, b, rows, values, part)
+    t1 = time.perf_counter()
+    ksp = pt.krylov(A, part, options, symmetric=symmetric)
+    x, its = pt.solve_ksp(ksp, b, part)
+    t2 = time.perf_counter()
+    u = part.gather(x)
+    ksp.destroy()
+    A.destroy()
+    return u, {"iterations": its, "t_assemble": t1 - t0,
+               "t_linear": t2 - t1}
+
+
+def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
+           maxiter=25, options=None, verbose=True):
+    r"""Newton's method for :math:`f_{int}(u) = \lambda f_{ext}`,
+    :math:`\lambda = 1/\mathrm{steps}, \dots, 1`, on a distributed model.
+
+    ``model`` is a displacement model (e.g.
+    :class:`~skfem_pg.formulations.Hyperelastic`) on the rank's local
+    basis (:meth:`Partition.basis`); ``f_ext`` and ``u_D`` (at load
+    factor 1) are serial vectors, ``D`` serial dofs.  A step converges when
+    :math:`|r_{free}| \le` ``tol`` :math:`\max(|\lambda f_{ext}|,
+    |r_0|)`; each linear solve is :func:`~skfem_pg.distributed.petsc.krylov`
+    (CG + GAMG, ``options`` override).  A step that does not converge
+    within ``maxiter``, or reaches :math:`J \le 0`, raises
+    :class:`~skfem_pg.solvers.ConvergenceError` (no step cutting here).
+
+    Returns ``(u, history)`` like :func:`skfem_pg.solvers.newton`: ``u``
+    in the serial numbering on every rank, ``history`` one dict per step
+    (load, residual norms, KSP iterations, minimum J, seconds).
+    """
+    MPI = mpi()
+    if getattr(model, "N", None) != getattr(model, "n_u", model.N):
+        raise NotImplementedError(
+            "{} has global extra fields; the distributed Newton solves "
+            "displacement models".format(type(model).__name__))
+    if model.N != len(part.local) * part.ncomp:
+        raise ValueError("the model is not on this partition's local "
+                         "basis ({} dofs, the partition has {} local dofs)"
+                         .format(model.N, len(part.local) * part.ncomp))
+    F = pt.from_serial(np.zeros(part.N) if f_ext is None else f_ext, part)
+    fnorm = F.norm()
+    rows, values = _dirichlet(part, D, u_D)
+    U = pt.empty_vector(part)
+    history = []
+    for step in range(1, steps + 1):
+        lam = step / steps
+        t_start = time.perf_counter()
+        info = {"load": lam, "residuals": [], "krylov": [], "min_J": np.nan,
+                "t_assemble": 0.0, "t_linear": 0.0}
+        prescribed = lam * values  # the first solve carries its increment
+        pending = len(rows) > 0 and part.comm.allreduce(
+            bool(np.any(prescribed != U.getValues(rows))), op=MPI.LOR)
+        ref = None
+        for it in range(maxiter + 1):
+            t0 = time.perf_counter()
+            state = model.state(pt.to_local(U, part))
+            info["min_J"] = part.comm.allreduce(model.min_J(state),
+                                                op=MPI.MIN)
+            if not info["min_J"] > 0:
+                raise ConvergenceError(
+                    "J <= 0 at load {:.4g}, iteration {}".format(lam, it),
+                    load=lam - 1.0 / steps)
+            R = pt.vector(-model.internal_force(state), part)
+            R.axpy(lam, F)  # R = lam f_ext - f_int
+            if len(rows):
+                R.setValues(rows, np.zeros(len(rows)))
+                R.assemble()
+            rn = R.norm()
+            info["residuals"].append(rn)
+            if not np.isfinite(rn):
+                raise ConvergenceError("non-finite residual at load {:.4g}"
+                                       .format(lam), load=lam - 1.0 / steps)
+            if not pending:
+                if ref is None:
+                    ref = max(lam * fnorm, rn, 1e-300)
+                if rn <= tol * ref:
+                    break
+            if it == maxiter:
+                raise ConvergenceError(
+                    "Newton did not converge at load {:.4g} in {} "
+                    "iterations (|r| {})".format(
+                        lam, maxiter, " ".join(
+                            "{:.1e}".format(r) for r in info["residuals"])),
+                    load=lam - 1.0 / steps)
+            K = pt.matrix(model.tangent(state), part)
+            inc = prescribed - U.getValues(rows) if pending else \
+                np.zeros(len(rows))
+            _lifted(K, R, rows, inc, part)
+            t1 = time.perf_counter()
+            ksp = pt.krylov(K, part, options)
+            dU, its = pt.solve_ksp(ksp, R, part)
+            ksp.destroy()
+            K.destroy()
+            U.axpy(1.0, dU)
+            pending = False
+            info["krylov"].append(its)
+            info["t_assemble"] += t1 - t0
+            info["t_linear"] += time.perf_counter() - t1
+        if hasattr(model, "commit"):
+            model.commit(state)
+        info["seconds"] = time.perf_counter() - t_start
+        history.append(info)
+        if verbose and part.rank == 0:
+            print("  load {:.4f}: {} it, |r| {}, KSP {}, min J {:.3g}"
+                  .format(lam, len(info["residuals"]) - 1, " ".join(
+                      "{:.1e}".format(r) for r in info["residuals"]),
+                      info["krylov"], info["min_J"]), flush=True)
+    return part.gather(U), history
