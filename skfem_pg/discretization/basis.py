@@ -44,7 +44,7 @@ from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
 from . import families as families_mod
-from . import corrections, petrov
+from . import petrov
 from .corrections import (bond_correction, check_correction,
                           correction_functions, family_radii, vc_correction)
 from ..dofs import as_dofs
@@ -157,13 +157,12 @@ class FamilyBasis(AbstractBasis):
         basis raises :class:`~skfem_pg.errors.CorrectionError` naming the worst
         particles.  ``None`` keeps an inexact correction with a warning
         (studies of the incompatible V2/V4/VC2 systems).
-    vc_correction
-        The function that corrects the derivatives of the unpadded PBG
-        path (default
-        :func:`~skfem_pg.discretization.corrections.vc_correction`); a
-        rank's part of a distributed basis gets
-        :meth:`skfem_pg.distributed.Partition.vc_correction`, which
-        solves the constraint system of all ranks' families.
+    distributed
+        Set by :meth:`skfem_pg.distributed.Partition.basis` on a rank's
+        part of a distributed basis: the partition, whose
+        ``vc_correction`` solves the constraint system of all ranks'
+        families and which supplies PPG1's test derivatives from the
+        halo's families; the families come pairwise-complete.
     test_shape
         PPG test derivatives at the masters: ``"master"`` (the trial
         basis' own derivative there: WTE1 = MTE1 at the master, or WTE2),
@@ -204,7 +203,7 @@ class FamilyBasis(AbstractBasis):
                  vc="auto", method="PBG", dim=None, weight_exponent=1,
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
                  test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
-                 vc_tolerance=1e-8, vc_correction=vc_correction):
+                 vc_tolerance=1e-8, distributed=None):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -266,7 +265,9 @@ class FamilyBasis(AbstractBasis):
             vc_exclude=vc_exclude, test_shape=test_shape, lme_mu=lme_mu,
             vc_boundary=vc_boundary, vc_tolerance=vc_tolerance)
         self.test_shape = test_shape
-        self._vc_correction = vc_correction
+        self.distributed = distributed
+        vc_correct = (vc_correction if distributed is None
+                      else distributed.vc_correction)
         self.weight_exponent = weight_exponent
         self.timings = {}
         x, V = particles.x, particles.volumes
@@ -285,7 +286,7 @@ class FamilyBasis(AbstractBasis):
             families = (families_mod.from_mesh(particles)
                         if particles.mesh is not None
                         else families_mod.horizon(particles))
-        if ppg:
+        if ppg and distributed is None:  # a partition's come complete
             families = petrov.pairwise(families)
         self.families = families
         self._check_families()
@@ -297,10 +298,12 @@ class FamilyBasis(AbstractBasis):
                     and vc in (None, "V3", "V5") and vc_exclude is None
                     and vc_boundary in ("min-norm", "p"))
         self._G = self._G_groups = None
-        if not unpadded and vc_correction is not corrections.vc_correction:
+        if distributed is not None and not unpadded and not (
+                method == "PPG1" and vc in (None, "V3")
+                and vc_boundary == "min-norm" and test_shape == "master"):
             raise NotImplementedError(
-                "a custom vc_correction (a distributed basis) is taken by "
-                "the unpadded PBG path only (MTE1/WTE1, vc V3/V5/None)")
+                "a distributed basis is PBG with MTE1/WTE1 and vc V3/V5 "
+                "or None, or PPG1 with vc V3 or None")
         if unpadded:  # the default: each size group without padding
             self._unpadded_pipeline(vc_solver, area_vectors, vc_tolerance)
         else:
@@ -368,7 +371,7 @@ class FamilyBasis(AbstractBasis):
                         exclude=vc_exclude)
                     Gt[:, 0] = Gm
                 elif ppg:  # (5.16) is (5.18) with the master weights only
-                    Gt, self.vc_report = vc_correction(
+                    Gt, self.vc_report = vc_correct(
                         Gt, dx_t, x, V, families, area_vectors, phi,
                         variant=vc, solver=vc_solver, exclude=vc_exclude,
                         boundary=vc_boundary, surface=surface)
@@ -419,8 +422,10 @@ class FamilyBasis(AbstractBasis):
         self.trial = None  # set on a PPG test basis: its trial basis
         if ppg:
             self.test = copy.copy(self)
-            self.test.G = petrov.element_test_gradients(Gt[:, 0], families,
-                                                         method)
+            self.test.G = petrov.element_test_gradients(
+                Gt[:, 0], families, method, reverse=None
+                if distributed is None else
+                distributed.reverse_master_derivatives(Gt[:, 0], families))
             self.test.trial = self
 
     @property
@@ -483,7 +488,9 @@ class FamilyBasis(AbstractBasis):
             area = self._area_vectors(area_vectors)
             phis = [correction_functions(self.vc, x, V, f, n=n)
                     for f in subs]
-            Gs, self.vc_report = self._vc_correction(
+            correct = (vc_correction if self.distributed is None
+                       else self.distributed.vc_correction)
+            Gs, self.vc_report = correct(
                 Gs, dxs, x, V, subs, area, phis, variant=self.vc,
                 solver=vc_solver, boundary=self.vc_boundary,
                 surface=(p.surface_area_vectors() if p.mesh is not None

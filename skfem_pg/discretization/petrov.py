@@ -92,13 +92,17 @@ def quadrature_weights(volumes, fam):
     return volumes[mem] * mask
 
 
-def element_test_gradients(Gt, fam, variant="PPG1"):
+def element_test_gradients(Gt, fam, variant="PPG1", reverse=None):
     """Test derivatives ``T[f, q, i]`` (shape ``(nf, m, m, d)``) of the
     element view from the master derivatives ``Gt[k, i]`` (``(nf, m, d)``:
-    derivative of member ``i`` of family ``k`` at its master)."""
+    derivative of member ``i`` of family ``k`` at its master).  PPG1 reads
+    :math:`G_t^{kkf}` from the family of each member ``k``; ``reverse``
+    gives them instead (``(nf, m, d)``, e.g. from other MPI ranks)."""
     mem, mask = fam.padded()
     nf, m, d = Gt.shape
-    if variant == "PPG1":
+    if variant == "PPG1" and reverse is not None:
+        g = reverse * mask[..., None]
+    elif variant == "PPG1":
         rev = reverse_slots(fam)
         index = np.full(fam.n_particles, -1, dtype=np.int64)
         index[fam.masters] = np.arange(nf)

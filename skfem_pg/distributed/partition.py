@@ -38,8 +38,10 @@ second at 10k particles in 3-D and linear with AMG
 """
 import numpy as np
 import scipy.sparse as sp
+import skfem as fem
 
 from ..discretization import families as families_mod
+from ..discretization import petrov
 from ..discretization.basis import FamilyBasis
 from ..discretization.corrections import (
     AMG_VC_LIMIT_3D, VCReport, _solve_pinned_lu, linear_fields, vc_apply,
@@ -78,7 +80,12 @@ def metis_parts(mesh, nparts):
                           "'skfem-pg[mpi]'") from err
     _, A = _vertex_graph(mesh)
     A.sort_indices()
-    _, parts = pymetis.part_graph(nparts, xadj=A.indptr, adjncy=A.indices)
+    if hasattr(pymetis, "CSRAdjacency"):  # pymetis >= 2025
+        _, parts = pymetis.part_graph(nparts, adjacency=pymetis.CSRAdjacency(
+            A.indptr, A.indices))
+    else:
+        _, parts = pymetis.part_graph(nparts, xadj=A.indptr,
+                                      adjncy=A.indices)
     return np.asarray(parts, dtype=np.int64)
 
 
@@ -109,6 +116,10 @@ class Partition:
         partitioned, so FE dofs have owners too.
     owner
         Optional owner rank per vertex (default: METIS).
+    fe_elements
+        The FE cells of a coupled model (default: the cells outside
+        ``elements``, none without it).  Rank ``r`` assembles the FE
+        cells whose first vertex it owns (:meth:`fe_assemble`).
 
     Attributes
     ----------
@@ -122,7 +133,8 @@ class Partition:
         ``(n,)`` PETSc particle index of each particle.
     """
 
-    def __init__(self, mesh, comm=None, elements=None, owner=None):
+    def __init__(self, mesh, comm=None, elements=None, owner=None,
+                 fe_elements=None):
         self.comm = as_mpi(comm)
         self.rank, self.size = self.comm.rank, self.comm.size
         self.mesh = mesh
@@ -148,6 +160,14 @@ class Partition:
         self.counts = np.bincount(owner, minlength=self.size)
         self.offsets = np.concatenate([[0], np.cumsum(self.counts)])
         self.owned = np.nonzero(owner == self.rank)[0]
+        if fe_elements is None:
+            fe = (np.zeros(0, dtype=np.int64) if elements is None else
+                  np.setdiff1d(np.arange(mesh.nelements),
+                               self.particles.elements))
+        else:
+            fe = np.asarray(mesh.normalize_elements(fe_elements),
+                            dtype=np.int64)
+        self.fe_cells = fe[owner[mesh.t[0, fe]] == self.rank]
         self._E = None
         self._area = None
 
@@ -180,12 +200,20 @@ class Partition:
         return cells if pel is None else np.intersect1d(cells, pel)
 
     # -- families and the local basis ---------------------------------------
-    def families(self, min_size=None):
+    def families(self, min_size=None, pairwise=False):
         """The families of the owned masters, in global particle numbers
         (mesh connectivity, as
-        :func:`~skfem_pg.discretization.families.from_mesh`)."""
-        ring = families_mod.from_mesh(self.mesh, elements=self.ring_cells(),
-                                      min_size=min_size)
+        :func:`~skfem_pg.discretization.families.from_mesh`); with
+        ``pairwise`` completed as
+        :func:`~skfem_pg.discretization.petrov.pairwise` (from the
+        families of twice as many rings: every family that may hold an
+        owned particle)."""
+        ring = families_mod.from_mesh(
+            self.mesh, elements=self.ring_cells(2 * RINGS if pairwise
+                                                else RINGS),
+            min_size=min_size)
+        if pairwise:
+            ring = petrov.pairwise(ring)
         mine = np.zeros(self.n, dtype=bool)
         mine[self.owned] = True
         mine &= self.particles.active
@@ -199,11 +227,9 @@ class Partition:
         (default :meth:`families`).  Sets :attr:`local` (local → global
         particle) and returns the basis."""
         method = options.get("method", "PBG")
-        if method != "PBG":
+        if method not in ("PBG", "PPG1"):
             raise NotImplementedError(
-                "method={!r} on MPI: the Petrov–Galerkin test basis needs "
-                "the master derivatives of the halo's families, which "
-                "this version does not exchange; use method='PBG'"
+                "method={!r} on MPI: this version distributes PBG and PPG1"
                 .format(method))
         if options.get("shape", "MTE1") not in ("MTE1", "WTE1"):
             raise NotImplementedError(
@@ -219,11 +245,14 @@ class Partition:
             raise NotImplementedError(
                 "vc={!r} on MPI: the distributed VC solve takes V3, V5 or "
                 "None".format(options["vc"]))
-        fam = self.families() if families is None else families
+        fam = (self.families(pairwise=method == "PPG1") if families is None
+               else families)
         if np.any(self.owner[fam.masters] != self.rank):
             raise ValueError("a rank's basis holds the families of its "
                              "owned masters only")
-        halo = np.setdiff1d(fam.members, self.owned)
+        halo = np.setdiff1d(np.union1d(fam.members,
+                                       self.mesh.t[:, self.fe_cells]),
+                            self.owned)
         local = np.concatenate([self.owned, halo])
         index = np.full(self.n, -1, dtype=np.int64)
         index[local] = np.arange(len(local))
@@ -239,10 +268,32 @@ class Partition:
         lfam = Families(fam.offsets, index[fam.members], len(local))
         if options.get("vc", "auto") is not None:
             options.setdefault("area_vectors", self.area_vectors()[:, local])
-        basis = FamilyBasis(lp, lfam, vc_correction=self.vc_correction,
-                            **options)
+        basis = FamilyBasis(lp, lfam, distributed=self, **options)
         self.ncomp = 1 if basis.ncomp is None else int(basis.ncomp)
         return basis
+
+    # -- FE cells of a coupled model ------------------------------------------
+    def fe_assemble(self, form, element, **kwargs):
+        """The rank's part of an FE form on its FE cells
+        (``fe_elements``), in the local numbering of :meth:`basis`: the
+        form assembled on ``skfem.Basis(mesh, element, elements=...)``
+        and restricted to the local dofs; zero on a rank without FE
+        cells.  Add it to the family basis' local matrix or vector."""
+        nc = self.ncomp
+        loc = self.local_serial_dofs()
+        if len(self.fe_cells) == 0:
+            if isinstance(form, fem.BilinearForm):
+                return sp.csr_matrix((len(loc), len(loc)))
+            return np.zeros(len(loc))
+        basis = fem.Basis(self.mesh, element, elements=self.fe_cells)
+        if basis.N != nc * self.n:
+            raise ValueError("the FE element has {} dofs, the particles {} "
+                             "({} per particle)".format(basis.N,
+                                                        nc * self.n, nc))
+        A = form.assemble(basis, **kwargs)
+        if sp.issparse(A):
+            return A.tocsr()[loc][:, loc]
+        return np.asarray(A)[loc]
 
     # -- the VC correction, assembled over ranks -----------------------------
     def sum_particles(self, r):
@@ -325,6 +376,46 @@ class Partition:
             iterations=its, seconds=time.perf_counter() - t0,
             boundary=boundary, particle_residuals=per[self.local])
         return (Gc if grouped else Gc[0]), rep
+
+    # -- PPG1: test derivatives from the halo's families ---------------------
+    def reverse_master_derivatives(self, Gt, fam):
+        r"""``g[f, q]`` :math:`= G_t^{kkf}`: the master derivative of the
+        family of member ``k = mem[f, q]`` with respect to master ``f``
+        (``Gt``: ``(nf, m, d)`` master derivatives of the rank's families,
+        ``fam`` its local families).  Families of halo members live on
+        their owners: the pairs are requested from them and answered
+        (two ``alltoall`` exchanges)."""
+        mem, mask = fam.padded()
+        n, d = self.n, Gt.shape[-1]
+        gm = self.local[mem]
+        gf = np.broadcast_to(self.local[fam.masters][:, None], mem.shape)
+        want_fam, want_mem = gm[mask], gf[mask]
+        dest = self.owner[want_fam]
+        order = np.argsort(dest, kind="stable")
+        cuts = np.cumsum(np.bincount(dest, minlength=self.size))[:-1]
+        asked = self.comm.alltoall(
+            np.split(np.stack([want_fam, want_mem])[:, order], cuts,
+                     axis=1))
+        keys = (gf * n + gm)[mask]
+        srt = np.argsort(keys)
+        values = Gt[mask][srt]
+        answers = []
+        for q in asked:
+            key = q[0] * n + q[1]
+            pos = np.minimum(np.searchsorted(keys[srt], key), len(srt) - 1)
+            bad = keys[srt][pos] != key
+            if np.any(bad):
+                raise ValueError(
+                    "families are not pairwise across ranks: particle {} "
+                    "is in the family of particle {} but not the other "
+                    "way round".format(q[0][bad][0], q[1][bad][0]))
+            answers.append(values[pos])
+        got = self.comm.alltoall(answers)
+        g = np.zeros(mem.shape + (d,))
+        flat = np.empty((len(order), d))
+        flat[order] = np.concatenate(got) if got else flat
+        g[mask] = flat
+        return g
 
     # -- numbering ---------------------------------------------------------
     @property

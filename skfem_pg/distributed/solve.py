@@ -77,9 +77,9 @@ def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True):
 
 
 def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
-           maxiter=25, options=None, verbose=True):
-    r"""Newton's method for :math:`f_{int}(u) = \lambda f_{ext}`,
-    :math:`\lambda = 1/\mathrm{steps}, \dots, 1`, on a distributed model.
+           maxiter=25, min_step=1.0 / 64, options=None, verbose=True):
+    r"""Newton's method for :math:`f_{int}(u) = \lambda f_{ext}` up to
+    :math:`\lambda = 1` on a distributed model, with adaptive load steps.
 
     ``model`` is a displacement model (e.g.
     :class:`~skfem_pg.formulations.Hyperelastic`) on the rank's local
@@ -88,14 +88,16 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
     :math:`|r_{free}| \le` ``tol`` :math:`\max(|\lambda f_{ext}|,
     |r_0|)`; each linear solve is :func:`~skfem_pg.distributed.petsc.krylov`
     (CG + GAMG, ``options`` override).  A step that does not converge
-    within ``maxiter``, or reaches :math:`J \le 0`, raises
-    :class:`~skfem_pg.solvers.ConvergenceError` (no step cutting here).
+    within ``maxiter``, or reaches :math:`J \le 0` or a non-finite
+    residual, is halved (the serial solver's policy, as are the doubling
+    after at most 4 iterations and the start ``steps``); below
+    ``min_step`` :class:`~skfem_pg.solvers.ConvergenceError` is raised.
 
     Returns ``(u, history)`` like :func:`skfem_pg.solvers.newton`: ``u``
-    in the serial numbering on every rank, ``history`` one dict per step
-    (load, residual norms, KSP iterations, minimum J, seconds).
+    in the serial numbering on every rank, ``history`` one dict per
+    converged step (load, residual norms, KSP iterations, minimum J,
+    seconds).
     """
-    MPI = mpi()
     if getattr(model, "N", None) != getattr(model, "n_u", model.N):
         raise NotImplementedError(
             "{} has global extra fields; the distributed Newton solves "
@@ -105,71 +107,94 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
                          "basis ({} dofs, the partition has {} local dofs)"
                          .format(model.N, len(part.local) * part.ncomp))
     F = pt.from_serial(np.zeros(part.N) if f_ext is None else f_ext, part)
-    fnorm = F.norm()
     rows, values = _dirichlet(part, D, u_D)
     U = pt.empty_vector(part)
     history = []
-    for step in range(1, steps + 1):
-        lam = step / steps
-        t_start = time.perf_counter()
-        info = {"load": lam, "residuals": [], "krylov": [], "min_J": np.nan,
-                "t_assemble": 0.0, "t_linear": 0.0}
-        prescribed = lam * values  # the first solve carries its increment
-        pending = len(rows) > 0 and part.comm.allreduce(
-            bool(np.any(prescribed != U.getValues(rows))), op=MPI.LOR)
-        ref = None
-        for it in range(maxiter + 1):
-            t0 = time.perf_counter()
-            state = model.state(pt.to_local(U, part))
-            info["min_J"] = part.comm.allreduce(model.min_J(state),
-                                                op=MPI.MIN)
-            if not info["min_J"] > 0:
-                raise ConvergenceError(
-                    "J <= 0 at load {:.4g}, iteration {}".format(lam, it),
-                    load=lam - 1.0 / steps)
-            R = pt.vector(-model.internal_force(state), part)
-            R.axpy(lam, F)  # R = lam f_ext - f_int
-            if len(rows):
-                R.setValues(rows, np.zeros(len(rows)))
-                R.assemble()
-            rn = R.norm()
-            info["residuals"].append(rn)
-            if not np.isfinite(rn):
-                raise ConvergenceError("non-finite residual at load {:.4g}"
-                                       .format(lam), load=lam - 1.0 / steps)
-            if not pending:
-                if ref is None:
-                    ref = max(lam * fnorm, rn, 1e-300)
-                if rn <= tol * ref:
-                    break
-            if it == maxiter:
-                raise ConvergenceError(
-                    "Newton did not converge at load {:.4g} in {} "
-                    "iterations (|r| {})".format(
-                        lam, maxiter, " ".join(
-                            "{:.1e}".format(r) for r in info["residuals"])),
-                    load=lam - 1.0 / steps)
-            K = pt.matrix(model.tangent(state), part)
-            inc = prescribed - U.getValues(rows) if pending else \
-                np.zeros(len(rows))
-            _lifted(K, R, rows, inc, part)
-            t1 = time.perf_counter()
-            ksp = pt.krylov(K, part, options)
-            dU, its = pt.solve_ksp(ksp, R, part)
-            ksp.destroy()
-            K.destroy()
-            U.axpy(1.0, dU)
-            pending = False
-            info["krylov"].append(its)
-            info["t_assemble"] += t1 - t0
-            info["t_linear"] += time.perf_counter() - t1
-        if hasattr(model, "commit"):
-            model.commit(state)
-        info["seconds"] = time.perf_counter() - t_start
-        history.append(info)
+    lam, dlam = 0.0, 1.0 / steps
+    while lam < 1.0 - 1e-14:
+        target = min(1.0, lam + dlam)
+        t0 = time.perf_counter()
+        ok, Uk, info, state = _newton_step(model, part, U, target, F, rows,
+                                           values, tol, maxiter, options)
+        info.update(load=target, seconds=time.perf_counter() - t0)
         if verbose and part.rank == 0:
-            print("  load {:.4f}: {} it, |r| {}, KSP {}, min J {:.3g}"
-                  .format(lam, len(info["residuals"]) - 1, " ".join(
-                      "{:.1e}".format(r) for r in info["residuals"]),
+            print("  load {:.4f}: {} in {} it, |r| {}, KSP {}, min J "
+                  "{:.3g}".format(
+                      target, "converged" if ok else "FAILED ({})".format(
+                          info["reason"]), len(info["residuals"]) - 1,
+                      " ".join("{:.1e}".format(r)
+                               for r in info["residuals"]),
                       info["krylov"], info["min_J"]), flush=True)
+        if ok:
+            if hasattr(model, "commit"):
+                model.commit(state)
+            U.destroy()
+            U, lam = Uk, target
+            history.append(info)
+            if len(info["residuals"]) <= 5:
+                dlam = min(2 * dlam, 1.0)
+            continue
+        Uk.destroy()
+        dlam = (target - lam) / 2
+        if dlam < min_step:
+            raise ConvergenceError(
+                "Newton failed at load factor {:.6g} ({}); the step fell "
+                "below min_step = {:.3g} after reaching load {:.6g}".format(
+                    target, info["reason"], min_step, lam), load=lam,
+                u=part.gather(U), history=history)
     return part.gather(U), history
+
+
+def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
+                 options):
+    """Newton iterations at load factor ``lam`` from the converged ``U0``
+    (not changed).  Returns ``(ok, U, info, state)``."""
+    MPI = mpi()
+    U = U0.copy()
+    info = {"residuals": [], "krylov": [], "min_J": np.nan, "reason": "",
+            "t_assemble": 0.0, "t_linear": 0.0}
+    prescribed = lam * values  # the first solve carries its increment
+    pending = part.comm.allreduce(
+        bool(np.any(prescribed != U.getValues(rows))) if len(rows)
+        else False, op=MPI.LOR)
+    ref = None
+    for it in range(maxiter + 1):
+        t0 = time.perf_counter()
+        state = model.state(pt.to_local(U, part))
+        info["min_J"] = part.comm.allreduce(model.min_J(state), op=MPI.MIN)
+        if not info["min_J"] > 0:
+            info["reason"] = "J <= 0"
+            return False, U, info, None
+        R = pt.vector(-model.internal_force(state), part)
+        R.axpy(lam, F)  # R = lam f_ext - f_int
+        if len(rows):
+            R.setValues(rows, np.zeros(len(rows)))
+        R.assemble()
+        rn = R.norm()
+        info["residuals"].append(rn)
+        if not np.isfinite(rn):
+            info["reason"] = "non-finite residual"
+            return False, U, info, None
+        if not pending:
+            if ref is None:
+                ref = max(lam * F.norm(), rn, 1e-300)
+            if rn <= tol * ref:
+                return True, U, info, state
+        if it == maxiter:
+            info["reason"] = "maxiter"
+            return False, U, info, None
+        K = pt.matrix(model.tangent(state), part)
+        inc = (prescribed - U.getValues(rows) if pending
+               else np.zeros(len(rows)))
+        _lifted(K, R, rows, inc, part)
+        t1 = time.perf_counter()
+        ksp = pt.krylov(K, part, options)
+        dU, its = pt.solve_ksp(ksp, R, part)
+        ksp.destroy()
+        K.destroy()
+        U.axpy(1.0, dU)
+        dU.destroy()
+        pending = False
+        info["krylov"].append(its)
+        info["t_assemble"] += t1 - t0
+        info["t_linear"] += time.perf_counter() - t1

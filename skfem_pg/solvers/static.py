@@ -255,7 +255,7 @@ LINE_SEARCH_HALVINGS = 4
 
 def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
                  line_search=False):
-    """Newton iterations at load factor ``lam`` from the converged ``u``;
+    r"""Newton iterations at load factor ``lam`` from the converged ``u``;
     ``u_DD`` are the prescribed values at ``Dd`` at this load.
 
     The increment of the prescribed displacements enters the first linear

@@ -1,0 +1,233 @@
+r"""PG on PETSc/MPI (skfem_pg.distributed) against the serial solutions.
+
+Run on two ranks (what CI does, .ci/run):
+
+    mpirun -n 2 python -m pytest -q -p no:cacheprovider \
+        tests/test_distributed.py
+
+On one rank (the plain test command) the same tests check the
+distributed path with a single part; without mpi4py, petsc4py and
+pymetis (the 'mpi' extra) they are skipped.
+"""
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
+from skfem_pg.analysis import PATCH_GRADIENT_3D as GEX3
+from skfem_pg.formulations import Hyperelastic, linear_elasticity
+from skfem_pg.materials import NeoHooke, lame
+from conftest import cube, square
+
+pytest.importorskip("mpi4py")
+pytest.importorskip("petsc4py")
+pytest.importorskip("pymetis")
+
+from mpi4py import MPI  # noqa: E402
+from skfem_pg import distributed as dist  # noqa: E402
+
+COMM = MPI.COMM_WORLD
+LAM, MU = lame(100.0, 0.3)
+FORM = linear_elasticity(LAM, MU)
+
+
+def same_on_all_ranks(u):
+    """Every rank gathered the same vector."""
+    return all(np.array_equal(u, v) for v in COMM.allgather(u))
+
+
+def rel(u, ref):
+    return np.abs(u - ref).max() / np.abs(ref).max()
+
+
+def cantilever3d(n=5):
+    """A distorted hex cube clamped at x = 0, a shear load at x = 1."""
+    mesh = cube(n, 0.2, seed=2)
+    e = fem.ElementVector(fem.ElementHex1())
+    fb = fem.FacetBasis(mesh, e, facets=mesh.facets_satisfying(
+        lambda x: np.isclose(x[0], 1)))
+    f = fem.LinearForm(lambda v, w: 5.0 * v[2] + 1.0 * v[1]).assemble(fb)
+    D = fem.Basis(mesh, e).get_dofs(lambda x: np.isclose(x[0], 0)).all()
+    return mesh, f, D
+
+
+def test_partition_owns_every_particle_once():
+    mesh = square(12, 0.3, seed=1)
+    part = dist.Partition(mesh, COMM)
+    owned = np.concatenate(COMM.allgather(part.owned))
+    assert np.array_equal(np.sort(owned), np.arange(mesh.nvertices))
+    counts = part.counts
+    assert counts.min() >= 0.8 * counts.max()  # METIS balance
+    # PETSc numbering: each rank's particles contiguous, ascending
+    ids = part.petsc_index[part.owned]
+    assert np.array_equal(ids, np.arange(part.offsets[part.rank],
+                                         part.offsets[part.rank + 1]))
+
+
+def test_rank_families_are_the_serial_ones():
+    """Families built from the rings of cells around the owned particles
+    equal the serial families of those masters (members in order)."""
+    mesh = cube(4, 0.25, seed=5, kind="tet")
+    part = dist.Partition(mesh, COMM)
+    serial = pg.families.from_mesh(mesh)
+    mine = part.families()
+    assert np.array_equal(mine.masters, part.owned)
+    assert np.array_equal(mine.sizes, serial.sizes[part.owned])
+    ref = np.concatenate([serial.members[serial.offsets[k]:
+                                         serial.offsets[k + 1]]
+                          for k in part.owned])
+    assert np.array_equal(mine.members, ref)
+
+
+def test_linear_elasticity_equals_serial():
+    mesh, f, D = cantilever3d()
+    sb = pg.FamilyBasis(mesh, dim=3)
+    u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=3)
+    assert basis.vc_report.residual_after < 1e-12
+    u, info = dist.solve(pg.assemble(FORM, basis), part, f, D=D)
+    assert rel(u, u_s) <= 1e-10  # measured 8e-13 (2 ranks)
+    assert same_on_all_ranks(u)
+    assert info["iterations"] < 100  # CG + GAMG with rigid-body modes
+
+
+def test_options_string_reaches_the_ksp():
+    mesh, f, D = cantilever3d(3)
+    sb = pg.FamilyBasis(mesh, dim=3)
+    u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
+    part = dist.Partition(mesh, COMM)
+    K = pg.assemble(FORM, part.basis(dim=3))
+    u, info = dist.solve(K, part, f, D=D,
+                         options="-ksp_type gmres -pc_type jacobi "
+                         "-ksp_gmres_restart 400")
+    assert rel(u, u_s) <= 1e-10
+    assert info["iterations"] > 30  # Jacobi: far more than GAMG's
+    with pytest.raises(ValueError, match="not an option"):
+        dist.solve(K, part, f, D=D, options="ksp_type cg")
+
+
+def test_neo_hooke_newton_equals_serial():
+    mesh, f, D = cantilever3d(4)
+    mat = NeoHooke(LAM, MU)
+    u_s, _ = pg.solvers.newton(Hyperelastic(pg.FamilyBasis(mesh, dim=3),
+                                            mat), 3 * f, D=D, steps=2,
+                               tol=1e-12, verbose=False)
+    part = dist.Partition(mesh, COMM)
+    model = Hyperelastic(part.basis(dim=3), mat)
+    u, hist = dist.newton(model, part, 3 * f, D=D, steps=2, verbose=False)
+    assert np.abs(u_s).max() > 0.1  # a nonlinear solve: 0.19 at the tip
+    assert rel(u, u_s) <= 1e-10  # measured 5e-14
+    assert hist[-1]["load"] == 1.0 and len(hist) >= 2  # steps adapt
+    for h in hist:  # quadratic convergence: a few iterations per step
+        assert len(h["residuals"]) <= 9
+        assert h["residuals"][-1] <= 1e-10 * max(h["residuals"])
+
+
+def test_prescribed_displacement_newton():
+    """Displacement-driven: the prescribed values enter the first solve."""
+    mesh = cube(3, 0.2, seed=4)
+    mat = NeoHooke(LAM, MU)
+    e = fem.ElementVector(fem.ElementHex1())
+    fb = fem.Basis(mesh, e)
+    D = fb.get_dofs(lambda x: np.isclose(x[0], 0) |
+                    np.isclose(x[0], 1)).all()
+    u_D = np.zeros(fb.N)
+    right = fb.get_dofs(lambda x: np.isclose(x[0], 1)).nodal["u^1"]
+    u_D[right] = 0.15
+    u_s, _ = pg.solvers.newton(Hyperelastic(pg.FamilyBasis(mesh, dim=3),
+                                            mat), D=D, u_D=u_D, steps=2,
+                               tol=1e-12, verbose=False)
+    part = dist.Partition(mesh, COMM)
+    u, _ = dist.newton(Hyperelastic(part.basis(dim=3), mat), part, D=D,
+                       u_D=u_D, steps=2, verbose=False)
+    assert rel(u, u_s) <= 1e-10
+
+
+@pytest.mark.parametrize("kw", [dict(), dict(vc_boundary="p"),
+                                dict(shape="WTE1", bond=False, vc="V3")])
+def test_patch_test(kw):
+    """Linear field on the boundary of a distorted square: exact inside."""
+    mesh = square(10, 0.3, seed=7, kind="tri")
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=2, **kw)
+    D = fem.Basis(mesh, fem.ElementVector(fem.ElementTriP1())).get_dofs()
+    uex = (GEX @ mesh.p).T.ravel()
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, D=D, u_D=uex)
+    assert np.abs(u - uex).max() <= 1e-10  # measured 1e-13
+
+
+def test_patch_test_3d():
+    mesh = cube(4, 0.25, seed=3, kind="tet")
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=3)
+    D = fem.Basis(mesh, fem.ElementVector(fem.ElementTetP1())).get_dofs()
+    uex = (GEX3 @ mesh.p).T.ravel()
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, D=D, u_D=uex)
+    assert np.abs(u - uex).max() <= 1e-10
+
+
+def test_ppg1_equals_serial():
+    """PPG1: pairwise families across ranks, test derivatives from the
+    halo's families, GMRES."""
+    mesh = square(12, 0.3, seed=3, kind="tri")
+    top = mesh.facets_satisfying(lambda x: np.isclose(x[1], 1))
+    sb = pg.FamilyBasis(mesh, dim=2, method="PPG1")
+    f = pg.traction(sb, top, [0.3, -1.0])
+    D = sb.get_dofs(mesh.facets_satisfying(lambda x: np.isclose(x[1], -1)))
+    u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=2, method="PPG1")
+    assert basis.test is not None
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=D.all(),
+                      symmetric=False)
+    assert rel(u, u_s) <= 1e-10  # measured 3e-13
+
+
+def test_coupled_fe_pg_patch_test():
+    """Q1 on the left, PG on the right, one PETSc system."""
+    mesh = square(10, 0.3, seed=7)
+    left = mesh.elements_satisfying(lambda x: x[0] < 0)
+    right = mesh.elements_satisfying(lambda x: x[0] >= 0)
+    e = fem.ElementVector(fem.ElementQuad1())
+    fe = fem.Basis(mesh, e, elements=left)
+    pgb = pg.FamilyBasis(pg.Particles.from_mesh(mesh, elements=right),
+                         dim=2)
+    eps = 0.5 * (GEX + GEX.T)
+    sigma = 2 * MU * eps + LAM * np.trace(eps) * np.eye(2)
+    top = mesh.facets_satisfying(lambda x: np.isclose(x[1], 1))
+    f = pg.stress_load(pgb, top, sigma)
+    D = fe.get_dofs(lambda x: np.isclose(np.abs(x[0]), 1) |
+                    np.isclose(x[1], -1)).all()
+    uex = (GEX @ mesh.p).T.ravel()
+    K_s = FORM.assemble(fe) + pg.assemble(FORM, pgb)
+    u_s = fem.solve(*fem.condense(K_s, f, x=uex, D=D))
+    part = dist.Partition(mesh, COMM, elements=right)
+    basis = part.basis(dim=2)
+    K = pg.assemble(FORM, basis) + part.fe_assemble(FORM, e)
+    u, _ = dist.solve(K, part, f, D=D, u_D=uex)
+    assert np.abs(u - uex).max() <= 1e-10  # measured 1e-13
+    assert rel(u, u_s) <= 1e-10
+    cells = COMM.allreduce(len(part.fe_cells))
+    assert cells == len(left)
+
+
+def test_unsupported_options_are_refused():
+    mesh = square(6)
+    part = dist.Partition(mesh, COMM)
+    for kw, what in ((dict(method="PPG2"), "PPG2"), (dict(vc="V4"), "V4"),
+                     (dict(shape="WTE2", bond=False), "WTE2"),
+                     (dict(vc_boundary="s"), "vc_boundary")):
+        with pytest.raises(NotImplementedError, match=what):
+            part.basis(dim=2, **kw)
+
+
+def test_bad_owner_is_refused():
+    mesh = square(4)
+    with pytest.raises(ValueError, match="owner"):
+        dist.Partition(mesh, COMM, owner=np.full(mesh.nvertices, 99))
+    if COMM.size > 1:
+        with pytest.raises(ValueError, match="owns no particle"):
+            dist.Partition(mesh, COMM,
+                           owner=np.zeros(mesh.nvertices, dtype=int))
