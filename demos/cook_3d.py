@@ -52,16 +52,7 @@ STYLES = {"O1": "k--o", "H1P0": "k-s", "VC PBG Unl": "C0-D",
 
 
 def cook3d(n, nz, distortion=0.0, seed=0):
-    m = fem.MeshHex.init_tensor(np.linspace(0, 1, n + 1),
-                                np.linspace(0, 1, n + 1),
-                                np.linspace(0, 1, nz + 1))
-    xi, eta, ze = m.p
-    p = np.array([48 * xi, 44 * xi + 44 * eta - 28 * xi * eta, T * ze])
-    mesh = fem.MeshHex(p, m.t)
-    if distortion:
-        mesh = pg.meshing.distort(mesh, distortion, seed)
-    return mesh.with_boundaries({"left": lambda x: np.isclose(x[0], 0),
-                                 "right": lambda x: np.isclose(x[0], 48)})
+    return pg.meshing.cook_membrane_3d(n, nz, T, distortion, seed)
 
 
 def scene(mesh):

@@ -20,7 +20,7 @@ import numpy as np
 
 from . import petsc as pt
 from .comm import mpi
-from ..solvers.static import ConvergenceError
+from ..solvers.static import ROUNDOFF_ENERGY, ConvergenceError
 
 
 def _dirichlet(part, D, u_D):
@@ -52,10 +52,13 @@ def _lifted(K, rhs, rows, values, part):
     return x
 
 
-def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True):
+def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True,
+          rtol=pt.RTOL):
     """Solve the linear system whose rank-local parts are ``K`` (scipy
     sparse, local dofs of ``part``'s basis) with the serial load ``f``
-    and Dirichlet dofs ``D`` (values ``u_D``, serial vectors).
+    and Dirichlet dofs ``D`` (values ``u_D``, serial vectors) by
+    :func:`~skfem_pg.distributed.petsc.krylov` (CG, GMRES if not
+    ``symmetric``; GAMG; relative tolerance ``rtol``; ``options``).
 
     Returns ``(u, info)``: ``u`` in the serial numbering on every rank,
     ``info`` with the KSP iterations and seconds for assembly and solve.
@@ -66,7 +69,7 @@ def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True):
     rows, values = _dirichlet(part, D, u_D)
     _lifted(A, b, rows, values, part)
     t1 = time.perf_counter()
-    ksp = pt.krylov(A, part, options, symmetric=symmetric)
+    ksp = pt.krylov(A, part, options, symmetric=symmetric, rtol=rtol)
     x, its = pt.solve_ksp(ksp, b, part)
     t2 = time.perf_counter()
     u = part.gather(x)
@@ -77,7 +80,8 @@ def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True):
 
 
 def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
-           maxiter=25, min_step=1.0 / 64, options=None, verbose=True):
+           maxiter=25, min_step=1.0 / 64, options=None, rtol=1e-8,
+           verbose=True):
     r"""Newton's method for :math:`f_{int}(u) = \lambda f_{ext}` up to
     :math:`\lambda = 1` on a distributed model, with adaptive load steps.
 
@@ -87,7 +91,9 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
     factor 1) are serial vectors, ``D`` serial dofs.  A step converges when
     :math:`|r_{free}| \le` ``tol`` :math:`\max(|\lambda f_{ext}|,
     |r_0|)`; each linear solve is :func:`~skfem_pg.distributed.petsc.krylov`
-    (CG + GAMG, ``options`` override).  A step that does not converge
+    (CG + GAMG to the relative tolerance ``rtol``, ``options``
+    override; the answer's accuracy is set by ``tol`` on the true
+    residual, an inexact solve only costs iterations).  A step that does not converge
     within ``maxiter``, or reaches :math:`J \le 0` or a non-finite
     residual, is halved (the serial solver's policy, as are the doubling
     after at most 4 iterations and the start ``steps``); below
@@ -115,7 +121,8 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
         ok, Uk, info, state = _newton_step(model, part, U, target, F, rows,
-                                           values, tol, maxiter, options)
+                                           values, tol, maxiter, options,
+                                           rtol)
         info.update(load=target, seconds=time.perf_counter() - t0)
         if verbose and part.rank == 0:
             print("  load {:.4f}: {} in {} it, |r| {}, KSP {}, min J "
@@ -146,13 +153,15 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
 
 
 def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
-                 options):
+                 options, rtol):
     """Newton iterations at load factor ``lam`` from the converged ``U0``
     (not changed).  Returns ``(ok, U, info, state)``."""
     MPI = mpi()
     U = U0.copy()
-    info = {"residuals": [], "krylov": [], "min_J": np.nan, "reason": "",
-            "t_assemble": 0.0, "t_linear": 0.0}
+    res, energy = [], []  # residual norms, |dU . R| per solve
+    info = {"residuals": res, "energies": energy, "krylov": [],
+            "min_J": np.nan, "reason": "", "t_assemble": 0.0,
+            "t_linear": 0.0}
     prescribed = lam * values  # the first solve carries its increment
     pending = part.comm.allreduce(
         bool(np.any(prescribed != U.getValues(rows))) if len(rows)
@@ -171,14 +180,19 @@ def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
             R.setValues(rows, np.zeros(len(rows)))
         R.assemble()
         rn = R.norm()
-        info["residuals"].append(rn)
+        res.append(rn)
         if not np.isfinite(rn):
             info["reason"] = "non-finite residual"
             return False, U, info, None
-        if not pending:
+        if not pending:  # the serial solver's criteria
             if ref is None:
                 ref = max(lam * F.norm(), rn, 1e-300)
-            if rn <= tol * ref:
+            if rn <= tol * ref or (len(energy) > 1
+                                   and energy[-1] <= tol ** 2 * energy[0]):
+                return True, U, info, state
+            if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
+                    and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
+                info["reason"] = "round-off floor"  # converged
                 return True, U, info, state
         if it == maxiter:
             info["reason"] = "maxiter"
@@ -188,10 +202,16 @@ def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
                else np.zeros(len(rows)))
         _lifted(K, R, rows, inc, part)
         t1 = time.perf_counter()
-        ksp = pt.krylov(K, part, options)
-        dU, its = pt.solve_ksp(ksp, R, part)
-        ksp.destroy()
-        K.destroy()
+        ksp = pt.krylov(K, part, options, rtol=rtol)
+        try:
+            dU, its = pt.solve_ksp(ksp, R, part)
+        except pt.KSPError as err:  # an indefinite tangent: cut the step
+            info["reason"] = "KSP diverged (reason {})".format(err.reason)
+            return False, U, info, None
+        finally:
+            ksp.destroy()
+            K.destroy()
+        energy.append(abs(dU.dot(R)))
         U.axpy(1.0, dU)
         dU.destroy()
         pending = False

@@ -81,6 +81,26 @@ def cook_membrane(n, kind="quad"):
     })
 
 
+def cook_membrane_3d(n, nz, thickness=10.0, distortion=0.0, seed=0):
+    """The 3-D Cook's membrane as a hexahedral grid: the 2-D outline of
+    :func:`cook_membrane` (``n`` × ``n`` cells) extruded by ``thickness``
+    in z (``nz`` cells), interior nodes optionally distorted by
+    ``±distortion·h`` (:func:`distort`); boundaries ``left`` and
+    ``right`` named."""
+    m = fem.MeshHex.init_tensor(np.linspace(0, 1, n + 1),
+                                np.linspace(0, 1, n + 1),
+                                np.linspace(0, 1, nz + 1))
+    p = np.vstack([_bilinear_map(m.p[0], m.p[1], COOK_CORNERS),
+                   thickness * m.p[2]])
+    mesh = fem.MeshHex(p, m.t)
+    if distortion:
+        mesh = distort(mesh, distortion, seed)
+    return mesh.with_boundaries({
+        "left": lambda x: np.isclose(x[0], 0.0),
+        "right": lambda x: np.isclose(x[0], 48.0),
+    })
+
+
 def annulus(n, a=1.0, b=2.0):
     """Quarter annulus :math:`a \\le r \\le b` of quadrilaterals, ``n``
     elements radially and ``2n`` around, with the boundaries ``inner``,
