@@ -27,8 +27,6 @@ out/cook_3d.png and a VTU with von Mises stress.
 """
 import os
 
-import numpy as np
-import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg import materials as mat
