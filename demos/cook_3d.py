@@ -27,7 +27,6 @@ out/cook_3d.png and a VTU with von Mises stress.
 """
 import os
 
-
 import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
