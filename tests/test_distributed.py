@@ -232,3 +232,25 @@ def test_bad_owner_is_refused():
         with pytest.raises(ValueError, match="owns no particle"):
             dist.Partition(mesh, COMM,
                            owner=np.zeros(mesh.nvertices, dtype=int))
+
+
+def test_scene_result_on_ranks():
+    """Scene.solve(..., comm=...) returns the serial Result's fields:
+    displacements, probes, reactions."""
+    from skfem_pg.scenes import Scene
+    mesh = cube(3, 0.2, seed=6).with_boundaries(
+        {"left": lambda x: np.isclose(x[0], 0),
+         "right": lambda x: np.isclose(x[0], 1)})
+    sc = Scene("cube", mesh, NeoHooke(LAM, MU), clamped=["left"],
+               tractions={"right": [0.0, 0.0, 2.0]},
+               probes={"corner": (1.0, 1.0, 1.0)}, steps=2)
+    r_s = sc.solve("VCPBG V5m Unl", tol=1e-12)
+    r = sc.solve("VCPBG V5m Unl", tol=1e-12, comm=COMM)
+    assert rel(r.u, r_s.u) <= 1e-10
+    assert np.allclose(r.probes["corner"], r_s.probes["corner"],
+                       rtol=1e-10, atol=0)
+    assert np.allclose(r.reaction("left"), r_s.reaction("left"),
+                       rtol=1e-8, atol=1e-10)
+    assert abs(r.reaction("left")[2] + 2.0) < 1e-8  # balances the load
+    with pytest.raises(NotImplementedError, match="UnlP0"):
+        sc.solve("VCPBG V5m UnlP0", comm=COMM)

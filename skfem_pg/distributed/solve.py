@@ -15,11 +15,13 @@ prescribed values lifted to the right-hand side (the serial solver's
 ``K_II u_I = f_I - K_ID u_D``).
 """
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from . import petsc as pt
 from .comm import mpi
+from ..scenes.scene import Result
 from ..solvers.static import ROUNDOFF_ENERGY, ConvergenceError
 
 
@@ -97,8 +99,10 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
 
     ``model`` is a displacement model (e.g.
     :class:`~skfem_pg.formulations.Hyperelastic`) on the rank's local
-    basis (:meth:`Partition.basis`); ``f_ext`` and ``u_D`` (at load
-    factor 1) are serial vectors, ``D`` serial dofs.  A step converges when
+    basis (:meth:`Partition.basis`); ``f_ext`` (at load factor 1) is a
+    serial vector, ``D`` serial dofs, ``u_D`` a serial vector at load
+    factor 1 (scaled) or a callable ``u_D(t)`` returning it at load
+    factor ``t`` (a rotation), as in the serial solver.  A step converges when
     :math:`|r_{free}| \le` ``tol`` :math:`\max(|\lambda f_{ext}|,
     |r_0|)`; each linear solve is :func:`~skfem_pg.distributed.petsc.krylov`
     (CG + GAMG to the relative tolerance ``rtol``, ``options``
@@ -123,7 +127,16 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
                          "basis ({} dofs, the partition has {} local dofs)"
                          .format(model.N, len(part.local) * part.ncomp))
     F = pt.from_serial(np.zeros(part.N) if f_ext is None else f_ext, part)
-    rows, values = _dirichlet(part, D, u_D)
+    if callable(u_D):
+        rows = _dirichlet(part, D, None)[0]
+
+        def prescribed(t):
+            return _dirichlet(part, D, u_D(t))[1]
+    else:
+        rows, values = _dirichlet(part, D, u_D)
+
+        def prescribed(t):
+            return t * values
     U = pt.empty_vector(part)
     history = []
     lam, dlam = 0.0, 1.0 / steps
@@ -131,8 +144,8 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
         ok, Uk, info, state = _newton_step(model, part, U, target, F, rows,
-                                           values, tol, maxiter, options,
-                                           rtol)
+                                           prescribed(target), tol, maxiter,
+                                           options, rtol)
         info.update(load=target, seconds=time.perf_counter() - t0)
         if verbose and part.rank == 0:
             print("  load {:.4f}: {} in {} it, |r| {}, KSP {}, min J "
@@ -162,17 +175,17 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
     return part.gather(U), history
 
 
-def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
+def _newton_step(model, part, U0, lam, F, rows, prescribed, tol, maxiter,
                  options, rtol):
     """Newton iterations at load factor ``lam`` from the converged ``U0``
-    (not changed).  Returns ``(ok, U, info, state)``."""
+    (not changed), ``prescribed`` the values at ``rows`` at this load.
+    Returns ``(ok, U, info, state)``."""
     MPI = mpi()
     U = U0.copy()
     res, energy = [], []  # residual norms, |dU . R| per solve
     info = {"residuals": res, "energies": energy, "krylov": [],
             "min_J": np.nan, "reason": "", "t_assemble": 0.0,
             "t_linear": 0.0}
-    prescribed = lam * values  # the first solve carries its increment
     pending = part.comm.allreduce(
         bool(np.any(prescribed != U.getValues(rows))) if len(rows)
         else False, op=MPI.LOR)
@@ -229,3 +242,18 @@ def _newton_step(model, part, U0, lam, F, rows, values, tol, maxiter,
         info["krylov"].append(its)
         info["t_assemble"] += t1 - t0
         info["t_linear"] += time.perf_counter() - t1
+
+
+@dataclass
+class DistributedResult(Result):
+    """A scene's :class:`~skfem_pg.scenes.scene.Result` from a distributed
+    solve: the same fields, in the serial numbering on every rank;
+    ``model`` is the rank's part, and :meth:`residual` (so
+    :meth:`reaction`) gathers the internal forces of all ranks."""
+    partition: object = None
+
+    def residual(self):
+        part = self.partition
+        x = self.x[part.local_serial_dofs()]
+        f = pt.vector(self.model.internal_force(self.model.state(x)), part)
+        return part.gather(f) - self.f_ext

@@ -42,7 +42,7 @@ import skfem as fem
 
 from ..discretization.basis import FamilyBasis
 from ..discretization.loads import traction as pg_traction
-from ..discretization.particles import Particles
+from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
 from ..formulations.updated_lagrange import UpdatedLagrange
 from ..solvers import newton
@@ -277,14 +277,23 @@ class Scene:
 
     # -- solving -------------------------------------------------------
     def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
-              tangent="consistent", tol=1e-9, **basis_kwargs):
+              tangent="consistent", tol=1e-9, comm=None, **basis_kwargs):
         """Solve with a thesis name (``"VCBCPBG V5sn UnlP0"``, ``"PBG
         IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
         basis options), ``"PG"`` (the displacement formulation;
         ``basis_kwargs`` go to ``FamilyBasis``, e.g. ``method="PPG1"``) or
         an FE method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``);
         ``tol``: Newton's relative residual tolerance
-        (:func:`~skfem_pg.solvers.newton`).  Returns a :class:`Result`."""
+        (:func:`~skfem_pg.solvers.newton`).  Returns a :class:`Result`.
+
+        ``comm`` (an MPI communicator): solve on its ranks with
+        :mod:`skfem_pg.distributed` (PG displacement formulations Unl/U1,
+        PBG or PPG1; ``solver`` is then a PETSc options string).  Every
+        rank gets the same :class:`Result`; its ``basis`` is the scikit-fem
+        basis of the collocation mesh (the same numbering)."""
+        if comm is not None:
+            return self._solve_distributed(scheme, comm, verbose, tangent,
+                                           tol, solver, basis_kwargs)
         basis, model, f, D, u_D, t_pre = self.setup(
             scheme, mesh, tangent, **basis_kwargs)
         x, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
@@ -299,6 +308,47 @@ class Scene:
             fields["ep"] = plastic[0]
         return Result(scheme, u, basis, self.evaluate(basis, u), times, hist,
                       fields=fields, model=model, x=x, f_ext=f)
+
+    def _solve_distributed(self, scheme, comm, verbose, tangent, tol,
+                           options, basis_kwargs):
+        from ..distributed import Partition, newton as dnewton
+        from ..distributed.solve import DistributedResult
+        from ..naming import fe_method, formulation_of, frame_of, parse
+        formulation, kw = "Unl", {}
+        if fe_method(scheme) or scheme in FE_METHODS:
+            raise NotImplementedError(
+                "{} on MPI: FE methods run on scikit-fem's own distributed "
+                "assembly (skfem.Dofs.decompose); the scene distributes PG"
+                .format(scheme))
+        if scheme != "PG":
+            kw, _ = parse(scheme)
+            formulation = formulation_of(scheme)
+        if formulation not in ("Unl", "U1") or frame_of(scheme) == "UL":
+            raise NotImplementedError(
+                "{} on MPI: the distributed Newton solves the displacement "
+                "formulations (Unl, U1) in the total Lagrangian frame"
+                .format(scheme))
+        t0 = time.perf_counter()
+        part = Partition(self.mesh, comm)
+        basis = part.basis(dim=self.dim, **{**kw, **basis_kwargs})
+        model = model_for(formulation, basis, self.material, tangent)
+        # the collocation mesh's FE basis: serial numbering, FE-consistent
+        # loads (those of PG without boundary variants), Dirichlet dofs
+        serial = fem.Basis(self.mesh, fem.ElementVector(
+            linear_elements(self.mesh)[0]))
+        f = sum((self._fe_traction(serial, self.mesh, n, t)
+                 for n, t in self.tractions.items()), np.zeros(serial.N))
+        D, u_D = self._dirichlet(serial)
+        t_pre = time.perf_counter() - t0
+        u, hist = dnewton(model, part, f, D=D, u_D=u_D, steps=self.steps,
+                          tol=tol, options=None if options == "auto"
+                          else options, verbose=verbose)
+        times = {"preprocess": t_pre,
+                 "assemble": sum(h["t_assemble"] for h in hist),
+                 "solve": sum(h["t_linear"] for h in hist)}
+        return DistributedResult(
+            scheme, u, serial, self.evaluate(serial, u, part.particles),
+            times, hist, model=model, x=u, f_ext=f, partition=part)
 
     def setup(self, scheme="PG", mesh=None, tangent="consistent",
               **basis_kwargs):
@@ -348,13 +398,16 @@ class Scene:
         D, u_D = self._dirichlet(basis)
         return basis, model, f, D, u_D, time.perf_counter() - t0
 
-    def evaluate(self, basis, u):
-        """Displacements at the probe points."""
+    def evaluate(self, basis, u, particles=None):
+        """Displacements at the probe points: at the particle there for
+        a family basis (or given ``particles``), else interpolated."""
         out = {}
         d = self.dim
+        if particles is None and isinstance(basis, FamilyBasis):
+            particles = basis.particles
         for label, x in self.probes.items():
-            if isinstance(basis, FamilyBasis):
-                p = basis.particles
+            if particles is not None:
+                p = particles
                 i = int(np.argmin(np.linalg.norm(p.x - x[:, None], axis=0)))
                 if np.linalg.norm(p.x[:, i] - x) > 1e-9 * max(1.0, np.abs(
                         x).max()):
