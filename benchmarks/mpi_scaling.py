@@ -9,7 +9,7 @@ on 1 and 2 ranks.  Weak: about twice the particles on 2 ranks.  Writes
 the table to the ``mpi_scaling`` section of benchmarks/README.md.
 
     python benchmarks/mpi_scaling.py [--strong 24x6 36x8] [--weak 24x6:30x8]
-        [--load 1] [--steps 1]
+        [--load 0.5] [--steps 1]
 
 Needs the 'mpi' extra and ``mpirun`` (README, "MPI").
 """
@@ -77,7 +77,7 @@ def main():
     ap = demo_parser(__doc__, results=True)
     ap.add_argument("--strong", nargs="+", default=["24x6", "36x8"])
     ap.add_argument("--weak", nargs="+", default=["24x6:30x8"])
-    ap.add_argument("--load", type=float, default=1.0)
+    ap.add_argument("--load", type=float, default=0.5)
     ap.add_argument("--steps", type=int, default=1)
     args = ap.parse_args()
     rows = []

@@ -254,3 +254,15 @@ def test_scene_result_on_ranks():
     assert abs(r.reaction("left")[2] + 2.0) < 1e-8  # balances the load
     with pytest.raises(NotImplementedError, match="UnlP0"):
         sc.solve("VCPBG V5m UnlP0", comm=COMM)
+
+
+def test_options_do_not_leak_into_the_next_solve():
+    from petsc4py import PETSc
+    mesh, f, D = cantilever3d(2)
+    part = dist.Partition(mesh, COMM)
+    K = pg.assemble(FORM, part.basis(dim=3))
+    dist.solve(K, part, f, D=D, options="-ksp_type gmres -pc_type jacobi")
+    A = dist.petsc.matrix(K, part)
+    ksp = dist.petsc.krylov(A, part)
+    assert (ksp.getType(), ksp.getPC().getType()) == ("cg", "gamg")
+    assert not PETSc.Options().hasName("skfem_pg_pc_type")
