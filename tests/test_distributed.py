@@ -106,6 +106,8 @@ def test_options_string_reaches_the_ksp():
     assert info["iterations"] > 30  # Jacobi: far more than GAMG's
     with pytest.raises(ValueError, match="not an option"):
         dist.solve(K, part, f, D=D, options="ksp_type cg")
+    with pytest.raises(ValueError, match="serial numbering"):
+        dist.solve(K, part, f, D=[-1])
 
 
 def test_neo_hooke_newton_equals_serial():
@@ -181,8 +183,8 @@ def test_ppg1_equals_serial():
     part = dist.Partition(mesh, COMM)
     basis = part.basis(dim=2, method="PPG1")
     assert basis.test is not None
-    u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=D.all(),
-                      symmetric=False)
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=D,
+                      symmetric=False)  # a DofsView
     assert rel(u, u_s) <= 1e-10  # measured 3e-13
 
 

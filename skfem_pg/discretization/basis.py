@@ -266,8 +266,9 @@ class FamilyBasis(AbstractBasis):
             vc_boundary=vc_boundary, vc_tolerance=vc_tolerance)
         self.test_shape = test_shape
         self.distributed = distributed
-        vc_correct = (vc_correction if distributed is None
-                      else distributed.vc_correction)
+        self._vc_correct = vc_correct = (
+            vc_correction if distributed is None
+            else distributed.vc_correction)
         self.weight_exponent = weight_exponent
         self.timings = {}
         x, V = particles.x, particles.volumes
@@ -488,9 +489,7 @@ class FamilyBasis(AbstractBasis):
             area = self._area_vectors(area_vectors)
             phis = [correction_functions(self.vc, x, V, f, n=n)
                     for f in subs]
-            correct = (vc_correction if self.distributed is None
-                       else self.distributed.vc_correction)
-            Gs, self.vc_report = correct(
+            Gs, self.vc_report = self._vc_correct(
                 Gs, dxs, x, V, subs, area, phis, variant=self.vc,
                 solver=vc_solver, boundary=self.vc_boundary,
                 surface=(p.surface_area_vectors() if p.mesh is not None

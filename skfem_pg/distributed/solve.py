@@ -21,17 +21,16 @@ import numpy as np
 
 from . import petsc as pt
 from .comm import mpi
+from ..dofs import as_dofs
 from ..scenes.scene import Result
 from ..solvers.static import ROUNDOFF_ENERGY, ConvergenceError
 
 
 def _dirichlet(part, D, u_D):
     """``(rows, values)``: the owned PETSc rows of the serial dofs ``D``
-    and the values of ``u_D`` (serial vector or None) there."""
-    D = np.unique(np.asarray([] if D is None else D, dtype=np.int64))
-    if len(D) and (D.min() < 0 or D.max() >= part.N):
-        raise ValueError("Dirichlet dofs must lie in 0..{}".format(
-            part.N - 1))
+    (indices or a scikit-fem ``DofsView``) and the values of ``u_D``
+    (serial vector or None) there."""
+    D = as_dofs(D, part.N, "Dirichlet dofs (serial numbering)")
     mine = D[part.owner[D // part.ncomp] == part.rank]
     rows = part.serial_to_petsc(mine)
     if u_D is None:
