@@ -23,6 +23,7 @@ benchmarks/mpi_scaling.py tabulates.
 """
 import json
 import os
+import resource
 import time
 
 import numpy as np
@@ -93,19 +94,20 @@ def main():
     t["total"] = time.perf_counter() - t_all
     its = [len(h["residuals"]) - 1 for h in hist]
     ksp = [k for h in hist for k in h["krylov"]]
-    per_rank = comm.gather(dict(t, owned=len(part.owned),
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    per_rank = comm.gather(dict(t, owned=len(part.owned), rss_mb=rss,
                                 halo=len(part.local) - len(part.owned),
                                 families=len(basis.families)), root=0)
     record = None
     if rank == 0:
         print("\nrank  owned  halo  partition  basis (VC)    assemble  "
-              "KSP     Newton  total [s]")
+              "KSP     Newton  total [s]  peak MB")
         for r, p in enumerate(per_rank):
             print("{:4d} {:6d} {:5d} {:10.2f} {:6.2f} ({:4.2f}) {:9.2f} "
-                  "{:6.2f} {:8.2f} {:6.2f}".format(
+                  "{:6.2f} {:8.2f} {:6.2f} {:8.0f}".format(
                       r, p["owned"], p["halo"], p["partition"], p["basis"],
                       p["vc"], p["assemble"], p["ksp"], p["newton"],
-                      p["total"]))
+                      p["total"], p["rss_mb"]))
         print("Newton: {} steps, iterations {}, KSP iterations {} (mean "
               "{:.1f})".format(len(hist), its, ksp, np.mean(ksp)))
         w = corner_w(mesh, u)

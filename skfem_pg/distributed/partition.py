@@ -263,8 +263,10 @@ class Partition:
         self._family_index[masters] = np.arange(len(masters))
         self._masters = masters
         p = self.particles
+        # an element subset, even empty, lets owned FE-only vertices
+        # (zero volume) stay in the local set; the families skip them
         lp = Particles(p.x[:, local], p.volumes[local],
-                       elements=np.arange(0))  # inactive owned allowed
+                       elements=np.arange(0))
         lfam = Families(fam.offsets, index[fam.members], len(local))
         if options.get("vc", "auto") is not None:
             options.setdefault("area_vectors", self.area_vectors()[:, local])
