@@ -271,3 +271,8 @@ def test_options_do_not_leak_into_the_next_solve():
     ksp = dist.petsc.krylov(A, part)
     assert (ksp.getType(), ksp.getPC().getType()) == ("cg", "gamg")
     assert not PETSc.Options().hasName("skfem_pg_pc_type")
+    # options GAMG reads at set-up (its levels') reach it too
+    smoother_its = ksp.getPC().getMGSmoother(1).getTolerances()[3]
+    ksp = dist.petsc.krylov(A, part, options="-mg_levels_ksp_max_it 3")
+    assert ksp.getPC().getMGSmoother(1).getTolerances()[3] == 3
+    assert smoother_its != 3

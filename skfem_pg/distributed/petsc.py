@@ -214,6 +214,7 @@ def krylov(A, part, options=None, symmetric=True, prefix="skfem_pg_",
         db[prefix + "pc_gamg_threshold"] = GAMG_THRESHOLD
         added.append(prefix + "pc_gamg_threshold")
     ksp.setFromOptions()
+    ksp.setUp()  # GAMG reads its levels' options here
     for key in added:  # this call's options, not the next solve's
         db.delValue(key)
     return ksp
