@@ -16,10 +16,11 @@ max|u - u_serial| / max|u_serial|.
 
 (as root, Open MPI needs ``--allow-run-as-root``; on two cores
 ``--oversubscribe`` lets ``-n 2`` start beside other processes.)  Writes
-out/cook_mpi_<ranks>.vtu (gathered displacements and the owner rank of
-each particle), out/cook_mpi_<ranks>.png (the partition on the deformed
-membrane) and, with ``--json FILE``, the timings that
-benchmarks/mpi_scaling.py tabulates.
+out/cook_mpi_<ranks>.pvtu with a VTU piece per rank (displacements and
+the owner rank of each particle; ParaView opens the .pvtu),
+out/cook_mpi_<ranks>.png (the partition on the deformed membrane) and,
+with ``--json FILE``, the timings that benchmarks/mpi_scaling.py
+tabulates.
 """
 import json
 import os
@@ -140,13 +141,12 @@ def main():
                               "sparse direct", tf, corner_w(mesh, u_h)))
         record.update(fe_seconds=tf, fe_w=corner_w(mesh, u_h))
     comm.barrier()
+    out = output_dir(args.out) if rank == 0 else None
+    name = os.path.join(comm.bcast(out), "cook_mpi_{}".format(size))
+    dist.write_pvtu(name + ".pvtu", part, u=u)  # a piece per rank
     if rank == 0:
-        out = output_dir(args.out)
-        name = os.path.join(out, "cook_mpi_{}".format(size))
-        pg.write_vtu(name + ".vtu", part.particles, u=u,
-                     rank=part.owner.astype(float))
         plot(part, u, name + ".png")
-        print("wrote {0}.vtu, {0}.png".format(name))
+        print("wrote {0}.pvtu ({1} piece(s)), {0}.png".format(name, size))
         if args.json:
             with open(args.json, "w") as fh:
                 json.dump(record, fh, indent=1)

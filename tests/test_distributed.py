@@ -276,3 +276,31 @@ def test_options_do_not_leak_into_the_next_solve():
     ksp = dist.petsc.krylov(A, part, options="-mg_levels_ksp_max_it 3")
     assert ksp.getPC().getMGSmoother(1).getTolerances()[3] == 3
     assert smoother_its != 3
+
+
+def test_parallel_vtu():
+    """One piece per rank, the .pvtu names them; the pieces hold every
+    cell once and the gathered values at their points."""
+    import os
+    import tempfile
+    import xml.etree.ElementTree as ET
+    import meshio
+    mesh = cube(3, 0.2, seed=1)
+    part = dist.Partition(mesh, COMM)
+    part.basis(dim=3)
+    u = np.arange(3 * mesh.nvertices, dtype=float)
+    root = COMM.bcast(tempfile.mkdtemp() if COMM.rank == 0 else None)
+    name = os.path.join(root, "cube.pvtu")
+    dist.write_pvtu(name, part, u=u)
+    sources = [p.get("Source") for p in ET.parse(name).iter("Piece")]
+    assert len(sources) == COMM.size
+    cells = 0
+    for s in sources:
+        m = meshio.read(os.path.join(root, s))
+        cells += len(m.cells[0].data)
+        k = np.argmin(((m.points[:, None, :] - mesh.p.T[None]) ** 2)
+                      .sum(-1), axis=1)
+        assert np.array_equal(m.point_data["u"], u.reshape(-1, 3)[k])
+    assert cells == mesh.nelements
+    with pytest.raises(ValueError, match="pvtu"):
+        dist.write_pvtu(os.path.join(root, "cube.vtu"), part, u=u)

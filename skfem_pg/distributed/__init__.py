@@ -9,6 +9,7 @@ particles it owns; PETSc sums the ranks' parts and solves.
                    (scikit-fem's MATIS route), KSP with GAMG and the
                    rigid-body near-null space, options strings
 ``solve``          linear solve and Newton's method on PETSc
+``io``             parallel VTU: a piece per rank and the ``.pvtu``
 ``comm``           the optional MPI stack (mpi4py, petsc4py, pymetis)
 =================  =====================================================
 
@@ -18,7 +19,8 @@ Run a script on two ranks with ``mpirun -n 2 python script.py``; see
 from .comm import as_mpi
 from .partition import Partition, metis_parts
 from .solve import solve, newton
+from .io import write_pvtu
 from . import petsc
 
 __all__ = ["Partition", "metis_parts", "solve", "newton", "petsc",
-           "as_mpi"]
+           "as_mpi", "write_pvtu"]

@@ -23,6 +23,15 @@ def write_vtu(filename, particles, **point_data):
     pts = np.zeros((n, 3))
     pts[:, :particles.dim] = particles.x.T
     data = {"volume": particles.volumes}
+    data.update(point_arrays(n, point_data))
+    meshio.write(filename, meshio.Mesh(pts, _cells(particles),
+                                       point_data=data))
+
+
+def point_arrays(n, point_data):
+    """``point_data`` as ParaView point arrays of ``n`` points (the
+    conversions of :func:`write_vtu`)."""
+    data = {}
     for name, val in point_data.items():
         val = np.asarray(val, dtype=float)
         if val.ndim == 1 and val.shape[0] != n and val.shape[0] % n == 0:
@@ -37,8 +46,7 @@ def write_vtu(filename, particles, **point_data):
         if val.ndim == 2 and val.shape[1] == 2:
             val = np.column_stack([val, np.zeros(n)])
         data[name] = val
-    meshio.write(filename, meshio.Mesh(pts, _cells(particles),
-                                       point_data=data))
+    return data
 
 
 def _cells(particles):
