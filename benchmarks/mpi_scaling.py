@@ -100,7 +100,8 @@ def main():
         rows += [c1, c2]
     header = ["scaling", "ranks", "grid", "particles", "dofs", "basis s",
               "assemble s", "KSP s", "total s", "Newton it", "KSP it/solve",
-              "speed-up", "serial PG s", "serial H1 s", "max diff. to serial PG"]
+              "speed-up", "serial PG s", "serial H1 s",
+              "max diff. to serial PG"]
     table = markdown_table(header, rows)
     print(table)
     text = (

@@ -101,21 +101,25 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
     basis (:meth:`Partition.basis`); ``f_ext`` (at load factor 1) is a
     serial vector, ``D`` serial dofs, ``u_D`` a serial vector at load
     factor 1 (scaled) or a callable ``u_D(t)`` returning it at load
-    factor ``t`` (a rotation), as in the serial solver.  A step converges when
-    :math:`|r_{free}| \le` ``tol`` :math:`\max(|\lambda f_{ext}|,
-    |r_0|)`; each linear solve is :func:`~skfem_pg.distributed.petsc.krylov`
-    (CG + GAMG to the relative tolerance ``rtol``, ``options``
-    override; the answer's accuracy is set by ``tol`` on the true
-    residual, an inexact solve only costs iterations).  A step that does not converge
-    within ``maxiter``, or reaches :math:`J \le 0` or a non-finite
-    residual, is halved (the serial solver's policy, as are the doubling
-    after at most 4 iterations and the start ``steps``); below
-    ``min_step`` :class:`~skfem_pg.solvers.ConvergenceError` is raised.
+    factor ``t`` (a rotation), as in the serial solver.
+
+    A step converges when :math:`|r_{free}| \le` ``tol``
+    :math:`\max(|\lambda f_{ext}|, |r_0|)`, or by the serial solver's
+    energy and round-off-floor criteria (:func:`skfem_pg.solvers.newton`).
+    Each linear solve is :func:`~skfem_pg.distributed.petsc.krylov` (CG +
+    GAMG to the relative tolerance ``rtol``; ``options`` override): the
+    answer's accuracy is set by ``tol`` on the true residual, an inexact
+    solve only costs iterations.  A step that does not converge within
+    ``maxiter``, reaches :math:`J \le 0` or a non-finite residual, or
+    whose Krylov solve diverges (an indefinite tangent far from
+    equilibrium) is halved; a step that converges in at most 4
+    iterations doubles the next (the serial policy).  Below ``min_step``
+    :class:`~skfem_pg.solvers.ConvergenceError` is raised.
 
     Returns ``(u, history)`` like :func:`skfem_pg.solvers.newton`: ``u``
     in the serial numbering on every rank, ``history`` one dict per
-    converged step (load, residual norms, KSP iterations, minimum J,
-    seconds).
+    converged step (load, residual norms, increment energies, KSP
+    iterations, minimum J, seconds).
     """
     if getattr(model, "N", None) != getattr(model, "n_u", model.N):
         raise NotImplementedError(
