@@ -81,10 +81,13 @@ def test_rank_families_are_the_serial_ones():
 
 
 @pytest.mark.parametrize("kw", [dict(), dict(vc=None),
-                                dict(shape="WTE1", vc="V3", bond=True)])
+                                dict(shape="WTE1", vc="V3", bond=True),
+                                dict(vc_solver="petsc"),
+                                dict(vc_solver="petsc", vc_boundary="p")])
 def test_linear_elasticity_equals_serial(kw):
     mesh, f, D = cantilever3d()
-    sb = pg.FamilyBasis(mesh, dim=3, **kw)
+    sb = pg.FamilyBasis(mesh, dim=3, **{k: v for k, v in kw.items()
+                                        if k != "vc_solver"})
     u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
     part = dist.Partition(mesh, COMM)
     basis = part.basis(dim=3, **kw)
@@ -164,10 +167,13 @@ def test_patch_test(kw):
     assert np.abs(u - uex).max() <= 1e-10  # measured 1e-13
 
 
-def test_patch_test_3d():
+@pytest.mark.parametrize("vc_solver", ["direct", "petsc"])
+def test_patch_test_3d(vc_solver):
+    """Also with the VC system solved on all ranks (GMRES, no gather)."""
     mesh = cube(4, 0.25, seed=3, kind="tet")
     part = dist.Partition(mesh, COMM)
-    basis = part.basis(dim=3)
+    basis = part.basis(dim=3, vc_solver=vc_solver)
+    assert basis.vc_report.solver.startswith(vc_solver)
     D = fem.Basis(mesh, fem.ElementVector(fem.ElementTetP1())).get_dofs()
     uex = (GEX3 @ mesh.p).T.ravel()
     u, _ = dist.solve(pg.assemble(FORM, basis), part, D=D, u_D=uex)

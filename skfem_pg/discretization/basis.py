@@ -128,7 +128,8 @@ class FamilyBasis(AbstractBasis):
         Solver of the VC constraint system: ``"auto"`` (``"direct"``, in
         3-D above 15k particles ``"amg"``), ``"direct"`` (scalar sparse
         LU), ``"amg"`` (the same scalar system by AMG-GMRES, linear in
-        the particle count) or ``"lsqr"``.
+        the particle count) or ``"lsqr"``; on a distributed basis also
+        ``"petsc"`` (:mod:`skfem_pg.distributed.vc`: solved on all ranks).
     area_vectors
         ``(dim, np)`` surface area vectors :math:`A^i`; default: the
         FE-consistent ones of ``particles.area_vectors()``.

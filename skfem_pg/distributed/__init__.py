@@ -9,6 +9,7 @@ particles it owns; PETSc sums the ranks' parts and solves.
                    (scikit-fem's MATIS route), KSP with GAMG and the
                    rigid-body near-null space, options strings
 ``solve``          linear solve and Newton's method on PETSc
+``vc``             the VC constraint system solved on all ranks (GMRES)
 ``io``             parallel VTU: a piece per rank and the ``.pvtu``
 ``comm``           the optional MPI stack (mpi4py, petsc4py, pymetis)
 =================  =====================================================
