@@ -323,7 +323,9 @@ class Partition:
         """:func:`~skfem_pg.discretization.corrections.vc_correction` of
         this rank's families with the global constraint system (module
         docstring): the arguments are the local ones, as the basis passes
-        them; the solve is rank 0's."""
+        them.  ``solver`` ``"direct"``/``"amg"`` (``"auto"``): rank 0
+        solves the gathered system with the serial code; ``"petsc"``: all
+        ranks (:func:`~skfem_pg.distributed.vc.solve_pinned`)."""
         import time
         t0 = time.perf_counter()
         grouped = isinstance(G, (list, tuple))
