@@ -50,14 +50,10 @@ import skfem as fem
 from ..discretization import families as families_mod
 from ..discretization import petrov
 from ..discretization.basis import FamilyBasis
-from ..discretization.corrections import (
-    AMG_VC_LIMIT_3D, VCReport, _solve_pinned_lu, anchor_particles,
-    linear_fields, vc_apply, vc_parts, vc_residual,
-    scalar_constraint_matrix)
 from ..discretization.families import Families
 from ..discretization.particles import Particles
 from .comm import as_mpi, petsc
-from .vc import solve_pinned
+from .vc import vc_correction
 
 #: cell rings around the owned particles from which their families are
 #: built: one for the family, three for from_mesh's enlargement
@@ -317,98 +313,10 @@ class Partition:
         self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
         return out
 
-    def vc_correction(self, G, dx, x, volumes, fam, area, phi,
-                      variant="V5", solver="auto", exclude=None,
-                      boundary="min-norm", surface=None, index=None):
-        """:func:`~skfem_pg.discretization.corrections.vc_correction` of
-        this rank's families with the global constraint system (module
-        docstring): the arguments are the local ones, as the basis passes
-        them.  ``solver`` ``"direct"``/``"amg"`` (``"auto"``): rank 0
-        solves the gathered system with the serial code; ``"petsc"``: all
-        ranks (:func:`~skfem_pg.distributed.vc.solve_pinned`)."""
-        import time
-        t0 = time.perf_counter()
-        grouped = isinstance(G, (list, tuple))
-        parts, masters_l, B_l, Qs = vc_parts(G, dx, fam, phi, index, x,
-                                             variant)
-        p, d = self.particles, x.shape[0]
-        xg, active = p.x, p.active
-        A = self.area_vectors()
-        fid = self._family_index[self.local[masters_l]]
-        r0 = self.sum_particles(
-            vc_residual(parts, [q[0] for q in parts], len(self.local))) \
-            - A.T
-        b = -r0.ravel()
-        P = linear_fields(xg, active)
-        b = b - P @ (P.T @ b)
-        PhiT = sum(scalar_constraint_matrix(ph, f, len(self.local), idx,
-                                            len(masters_l))
-                   for _, _, f, ph, idx in parts).tocoo()
-        rows = self.local[PhiT.row]
-        nf = len(self._masters)
-        if solver == "auto":
-            solver = ("amg" if d == 3 and int(active.sum()) > AMG_VC_LIMIT_3D
-                      else "direct")
-        if solver not in ("direct", "amg", "petsc"):
-            raise NotImplementedError(
-                "vc_solver={!r} on MPI: use 'direct' or 'amg' (rank 0 "
-                "solves the pinned scalar system) or 'petsc' (all ranks)"
-                .format(solver))
-        if solver == "petsc":
-            mp = self.local[masters_l]  # the families' master particles
-            al, its = solve_pinned(
-                self, rows, mp[PhiT.col], PhiT.data, mp, B_l,
-                b.reshape(-1, d), anchor_particles(xg, active),
-                min_norm=boundary == "min-norm")
-            return self._vc_finish(parts, Qs, al, r0, grouped, variant,
-                                   solver, nf, its, boundary, t0)
-        cols = fid[PhiT.col]
-        got = self.comm.gather((rows, cols, PhiT.data, fid, B_l), root=0)
-        alpha = err = None
-        if self.rank == 0:
-            R = np.concatenate([g[0] for g in got])
-            C = np.concatenate([g[1] for g in got])
-            V = np.concatenate([g[2] for g in got])
-            Bg = np.empty((nf, d, d))
-            for g in got:
-                Bg[g[3]] = g[4]
-            M = sp.csr_matrix((V, (R, C)), shape=(self.n, nf))
-            try:
-                alpha, its, used = _solve_pinned_lu(
-                    M, self._masters, Bg, b, xg, active,
-                    min_norm=boundary == "min-norm",
-                    iterative=solver == "amg")
-            except RuntimeError as e:
-                err = str(e)
-        alpha, its, err = self.comm.bcast(
-            (alpha, its if alpha is not None else 0, err), root=0)
-        if err is not None:
-            raise RuntimeError("the distributed VC solve failed on rank 0: "
-                               "{}".format(err))
-        return self._vc_finish(parts, Qs, alpha.reshape(-1, d)[fid], r0,
-                               grouped, variant, solver + " (rank 0)", nf,
-                               its, boundary, t0)
-
-    def _vc_finish(self, parts, Qs, alpha, r0, grouped, variant, solver, nf,
-                   its, boundary, t0):
-        """Apply ``alpha`` (the rank's families) and report."""
-        import time
-        p, A = self.particles, self.area_vectors()
-        active, d = p.active, p.dim
-        Gc = vc_apply(parts, Qs, alpha)
-        r1 = self.sum_particles(
-            vc_residual(parts, Gc, len(self.local))) - A.T
-        h = np.mean(p.volumes[active]) ** (1.0 / d)
-        scale = h ** (d - 1)
-        per = np.abs(r1 * active[:, None]).max(axis=1) / scale
-        rep = VCReport(
-            variant=variant, solver=solver, unknowns=d * nf,
-            constraints=int(active.sum()) * d,
-            residual_before=float(np.abs(r0[active]).max() / scale),
-            residual_after=float(np.abs(r1[active]).max() / scale),
-            iterations=its, seconds=time.perf_counter() - t0,
-            boundary=boundary, particle_residuals=per[self.local])
-        return (Gc if grouped else Gc[0]), rep
+    def vc_correction(self, *args, **kwargs):
+        """:func:`skfem_pg.distributed.vc.vc_correction` on this partition
+        (what a rank's :class:`~skfem_pg.FamilyBasis` calls)."""
+        return vc_correction(self, *args, **kwargs)
 
     # -- PPG1: test derivatives from the halo's families ---------------------
     def reverse_master_derivatives(self, Gt, fam):

@@ -16,11 +16,23 @@ the ``d + 1`` null vectors :math:`z`; the minimum-norm projection of
 :math:`(d + 1)d`-square normal equations, summed over ranks.  So no rank
 holds more than its own families; the answer equals the serial one to the
 Krylov tolerance.
+
+:func:`vc_correction` is what a rank's basis calls (through
+:meth:`Partition.vc_correction`): it assembles the pieces of its
+families and solves on rank 0 (the serial code) or, with
+``vc_solver="petsc"``, by :func:`solve_pinned` on all ranks.
 """
+import time
+
 import numpy as np
+import scipy.sparse as sp
 
 from . import petsc as pt
 from .comm import mpi, petsc
+from ..discretization.corrections import (
+    AMG_VC_LIMIT_3D, VCReport, _solve_pinned_lu, anchor_particles,
+    linear_fields, scalar_constraint_matrix, vc_apply, vc_parts,
+    vc_residual)
 
 #: relative tolerance of the pinned solves (the serial LU reaches round-off)
 RTOL = 1e-14
@@ -122,3 +134,95 @@ def solve_pinned(part, rows, cols, vals, fid, B, b, anchors, min_norm=True):
     r = part.comm.allreduce(Z.T @ alpha.ravel(), op=MPI.SUM)
     coef = np.linalg.lstsq(G, r, rcond=None)[0]
     return (alpha.ravel() - Z @ coef).reshape(nf, d), its
+
+
+def vc_correction(part, G, dx, x, volumes, fam, area, phi, variant="V5",
+                  solver="auto", exclude=None, boundary="min-norm",
+                  surface=None, index=None):
+    """:func:`~skfem_pg.discretization.corrections.vc_correction` of the
+    families of partition ``part`` with the global constraint system
+    (:mod:`~skfem_pg.distributed.partition`): the arguments are the local
+    ones, as the basis passes them.  ``solver`` ``"direct"``/``"amg"``
+    (``"auto"``): rank 0 solves the gathered system with the serial code;
+    ``"petsc"``: all ranks (:func:`solve_pinned`)."""
+    t0 = time.perf_counter()
+    grouped = isinstance(G, (list, tuple))
+    parts, masters_l, B_l, Qs = vc_parts(G, dx, fam, phi, index, x,
+                                         variant)
+    p, d = part.particles, x.shape[0]
+    xg, active = p.x, p.active
+    A = part.area_vectors()
+    fid = part._family_index[part.local[masters_l]]
+    r0 = part.sum_particles(
+        vc_residual(parts, [q[0] for q in parts], len(part.local))) \
+        - A.T
+    b = -r0.ravel()
+    P = linear_fields(xg, active)
+    b = b - P @ (P.T @ b)
+    PhiT = sum(scalar_constraint_matrix(ph, f, len(part.local), idx,
+                                        len(masters_l))
+               for _, _, f, ph, idx in parts).tocoo()
+    rows = part.local[PhiT.row]
+    nf = len(part._masters)
+    if solver == "auto":
+        solver = ("amg" if d == 3 and int(active.sum()) > AMG_VC_LIMIT_3D
+                  else "direct")
+    if solver not in ("direct", "amg", "petsc"):
+        raise NotImplementedError(
+            "vc_solver={!r} on MPI: use 'direct' or 'amg' (rank 0 "
+            "solves the pinned scalar system) or 'petsc' (all ranks)"
+            .format(solver))
+    if solver == "petsc":
+        mp = part.local[masters_l]  # the families' master particles
+        al, its = solve_pinned(
+            part, rows, mp[PhiT.col], PhiT.data, mp, B_l,
+            b.reshape(-1, d), anchor_particles(xg, active),
+            min_norm=boundary == "min-norm")
+        return _finish(part, parts, Qs, al, r0, grouped, variant, solver,
+                       nf, its, boundary, t0)
+    cols = fid[PhiT.col]
+    got = part.comm.gather((rows, cols, PhiT.data, fid, B_l), root=0)
+    alpha = err = None
+    if part.rank == 0:
+        R = np.concatenate([g[0] for g in got])
+        C = np.concatenate([g[1] for g in got])
+        V = np.concatenate([g[2] for g in got])
+        Bg = np.empty((nf, d, d))
+        for g in got:
+            Bg[g[3]] = g[4]
+        M = sp.csr_matrix((V, (R, C)), shape=(part.n, nf))
+        try:
+            alpha, its, _ = _solve_pinned_lu(
+                M, part._masters, Bg, b, xg, active,
+                min_norm=boundary == "min-norm",
+                iterative=solver == "amg")
+        except RuntimeError as e:
+            err = str(e)
+    alpha, its, err = part.comm.bcast(
+        (alpha, its if alpha is not None else 0, err), root=0)
+    if err is not None:
+        raise RuntimeError("the distributed VC solve failed on rank 0: "
+                           "{}".format(err))
+    return _finish(part, parts, Qs, alpha.reshape(-1, d)[fid], r0, grouped,
+                   variant, solver + " (rank 0)", nf, its, boundary, t0)
+
+
+def _finish(part, parts, Qs, alpha, r0, grouped, variant, solver, nf, its,
+            boundary, t0):
+    """Apply ``alpha`` (the rank's families) and report."""
+    p, A = part.particles, part.area_vectors()
+    active, d = p.active, p.dim
+    Gc = vc_apply(parts, Qs, alpha)
+    r1 = part.sum_particles(
+        vc_residual(parts, Gc, len(part.local))) - A.T
+    h = np.mean(p.volumes[active]) ** (1.0 / d)
+    scale = h ** (d - 1)
+    per = np.abs(r1 * active[:, None]).max(axis=1) / scale
+    rep = VCReport(
+        variant=variant, solver=solver, unknowns=d * nf,
+        constraints=int(active.sum()) * d,
+        residual_before=float(np.abs(r0[active]).max() / scale),
+        residual_after=float(np.abs(r1[active]).max() / scale),
+        iterations=its, seconds=time.perf_counter() - t0,
+        boundary=boundary, particle_residuals=per[part.local])
+    return (Gc if grouped else Gc[0]), rep
