@@ -4,12 +4,14 @@ particles it owns; PETSc sums the ranks' parts and solves.
 =================  =====================================================
 ``partition``      :class:`Partition`: METIS split of the particles, the
                    rank's families and local basis (owned + halo
-                   particles), numbering, the VC correction over ranks
+                   particles), numbering, PPG1's halo exchange
+``vc``             the VC correction over ranks: the constraint system
+                   of all ranks' families, solved on rank 0 or (GMRES)
+                   on all ranks
 ``petsc``          local matrices/vectors into distributed PETSc ones
-                   (scikit-fem's MATIS route), KSP with GAMG and the
+                   (rows summed by their owners), KSP with GAMG and the
                    rigid-body near-null space, options strings
 ``solve``          linear solve and Newton's method on PETSc
-``vc``             the VC constraint system solved on all ranks (GMRES)
 ``io``             parallel VTU: a piece per rank and the ``.pvtu``
 ``comm``           the optional MPI stack (mpi4py, petsc4py, pymetis)
 =================  =====================================================
