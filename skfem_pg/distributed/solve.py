@@ -23,7 +23,7 @@ from . import petsc as pt
 from .comm import mpi
 from ..dofs import as_dofs
 from ..scenes.scene import Result
-from ..solvers.static import ROUNDOFF_ENERGY, ConvergenceError
+from ..solvers.static import ConvergenceError, verdict
 
 
 def _dirichlet(part, D, u_D):
@@ -213,13 +213,9 @@ def _newton_step(model, part, U0, lam, F, rows, prescribed, tol, maxiter,
         if not pending:  # the serial solver's criteria
             if ref is None:
                 ref = max(lam * F.norm(), rn, 1e-300)
-            if rn <= tol * ref or (len(energy) > 1
-                                   and energy[-1] <= tol ** 2 * energy[0]):
-                return True, U, info, state
-            if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
-                    and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
-                info["reason"] = "round-off floor"  # converged
-                return True, U, info, state
+            done, info["reason"] = verdict(res, energy, ref, tol)
+            if done is not None:
+                return done, U, info, state if done else None
         if it == maxiter:
             info["reason"] = "maxiter"
             return False, U, info, None

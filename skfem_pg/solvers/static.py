@@ -249,6 +249,25 @@ def _small_increment(model, du, u):
                <= 1e-10 * np.abs(u[b]).max(initial=0.0) for _, b in blocks)
 
 
+def verdict(res, energy, ref, tol, small=False):
+    """The convergence criteria of :func:`newton` (its ``tol``) after a
+    residual norm ``res[-1]``: ``res`` the step's norms, ``energy`` its
+    increments' :math:`|\\Delta x\\cdot r|`, ``ref`` the reference norm,
+    ``small`` an increment below 1e-10 of the unknowns.  Returns ``(True,
+    "")`` converged, ``(True, "round-off floor")`` converged where the
+    residual stalls, ``(False, "diverging")``, or ``(None, "")`` go on."""
+    rn = res[-1]
+    if rn <= tol * ref or small or (
+            len(energy) > 1 and energy[-1] <= tol ** 2 * energy[0]):
+        return True, ""
+    if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
+            and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
+        return True, "round-off floor"
+    if len(res) >= 4 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
+        return False, "diverging"
+    return None, ""
+
+
 #: halvings of a Newton increment at most (``line_search``)
 LINE_SEARCH_HALVINGS = 4
 
@@ -321,16 +340,9 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
         if not pending:
             if ref is None:
                 ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
-            if rn <= tol * ref or small or (
-                    len(energy) > 1 and energy[-1] <= tol ** 2 * energy[0]):
-                return True, u, info, state
-            if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
-                    and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
-                info["reason"] = "round-off floor"  # converged
-                return True, u, info, state
-            if it >= 3 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
-                info["reason"] = "diverging"
-                return False, u, info, None
+            done, info["reason"] = verdict(res, energy, ref, tol, small)
+            if done is not None:
+                return done, u, info, state if done else None
         if it == maxiter:
             info["reason"] = "maxiter"
             return False, u, info, None
