@@ -313,16 +313,13 @@ class Scene:
                            options, basis_kwargs):
         from ..distributed import Partition, newton as dnewton
         from ..distributed.solve import DistributedResult
-        from ..naming import fe_method, formulation_of, frame_of, parse
-        formulation, kw = "Unl", {}
-        if fe_method(scheme) or scheme in FE_METHODS:
+        from ..naming import frame_of
+        method, formulation, basis_kwargs = _scheme(scheme, basis_kwargs)
+        if method != "PG":
             raise NotImplementedError(
                 "{} on MPI: FE methods run on scikit-fem's own distributed "
                 "assembly (skfem.Dofs.decompose); the scene distributes PG"
                 .format(scheme))
-        if scheme != "PG":
-            kw, _ = parse(scheme)
-            formulation = formulation_of(scheme)
         if formulation not in ("Unl", "U1") or frame_of(scheme) == "UL":
             raise NotImplementedError(
                 "{} on MPI: the distributed Newton solves the displacement "
@@ -330,7 +327,7 @@ class Scene:
                 .format(scheme))
         t0 = time.perf_counter()
         part = Partition(self.mesh, comm)
-        basis = part.basis(dim=self.dim, **{**kw, **basis_kwargs})
+        basis = part.basis(dim=self.dim, **basis_kwargs)
         model = model_for(formulation, basis, self.material, tangent)
         # the collocation mesh's FE basis: serial numbering, FE-consistent
         # loads (those of PG without boundary variants), Dirichlet dofs
@@ -358,21 +355,9 @@ class Scene:
         name in the updated Lagrangian frame (``"... Unl UL"``) gives an
         :class:`~skfem_pg.formulations.UpdatedLagrange` model, rebuilt
         every ``params["ul_every"]`` converged steps (default 1)."""
-        from ..naming import fe_method, formulation_of, frame_of, parse
-        method = fe_method(scheme) or scheme
+        from ..naming import frame_of
         t0 = time.perf_counter()
-        formulation = "Unl"
-        if method not in FE_METHODS and method != "PG":
-            try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
-                kw, _ = parse(method)
-            except ValueError as err:
-                raise ValueError("unknown method {!r}: 'PG', a thesis name "
-                                 "(e.g. 'VCPBG Unl') or one of {} ({})"
-                                 .format(method, ", ".join(FE_METHODS),
-                                         err)) from None
-            basis_kwargs = {**kw, **basis_kwargs}
-            formulation = formulation_of(method)
-            method = "PG"
+        method, formulation, basis_kwargs = _scheme(scheme, basis_kwargs)
         if method == "PG":
             mesh = self.mesh if mesh is None else mesh
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
@@ -418,6 +403,24 @@ class Scene:
                 xi = inside(basis.mesh, x[:, None])
                 out[label] = (basis.probes(xi) @ u).reshape(d)
         return out
+
+
+def _scheme(scheme, basis_kwargs):
+    """``(method, formulation, basis_kwargs)`` of a scene method name:
+    ``method`` is the FE method of :data:`FE_METHODS` or ``"PG"`` (for
+    ``"PG"`` and thesis names, whose basis options are merged under the
+    given ``basis_kwargs``)."""
+    from ..naming import fe_method, formulation_of, parse
+    method = fe_method(scheme) or scheme
+    if method in FE_METHODS or method == "PG":
+        return method, "Unl", basis_kwargs
+    try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
+        kw, _ = parse(method)
+    except ValueError as err:
+        raise ValueError("unknown method {!r}: 'PG', a thesis name (e.g. "
+                         "'VCPBG Unl') or one of {} ({})".format(
+                             method, ", ".join(FE_METHODS), err)) from None
+    return "PG", formulation_of(method), {**kw, **basis_kwargs}
 
 
 def _callable_key(f):
