@@ -263,7 +263,6 @@ class Partition:
         index = np.full(self.n, -1, dtype=np.int64)
         index[local] = np.arange(len(local))
         self.local = local
-        self._local_index = index
         masters = np.sort(np.concatenate(self.comm.allgather(fam.masters)))
         self._family_index = np.full(self.n, -1, dtype=np.int64)
         self._family_index[masters] = np.arange(len(masters))
@@ -309,7 +308,7 @@ class Partition:
         summed over all ranks into ``(n, ...)`` on every rank."""
         from mpi4py import MPI
         out = np.zeros((self.n,) + r.shape[1:])
-        np.add.at(out, self.local, r)
+        out[self.local] = r  # each local particle once
         self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
         return out
 

@@ -138,18 +138,20 @@ def to_local(v, part):
 
 def rigid_body_modes(part):
     """``MatNullSpace`` of the rigid-body modes of the owned particles
-    (GAMG's near-null space); ``None`` for a scalar field."""
+    (GAMG's near-null space; built once per partition); ``None`` for a
+    scalar field."""
     PETSc = petsc()
     d = part.dim
     if part.ncomp != d:
         return None
-    x = part.particles.x[:, part.owned].T.ravel()
-    coords = PETSc.Vec().createMPI((len(x), d * part.n), bsize=d,
-                                   comm=part.petsc_comm)
-    coords.setArray(x)
-    ns = PETSc.NullSpace().createRigidBody(coords)
-    coords.destroy()
-    return ns
+    if getattr(part, "_rigid_body_modes", None) is None:
+        x = part.particles.x[:, part.owned].T.ravel()
+        coords = PETSc.Vec().createMPI((len(x), d * part.n), bsize=d,
+                                       comm=part.petsc_comm)
+        coords.setArray(x)
+        part._rigid_body_modes = PETSc.NullSpace().createRigidBody(coords)
+        coords.destroy()
+    return part._rigid_body_modes
 
 
 def _options(prefix, options):

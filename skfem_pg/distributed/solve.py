@@ -44,13 +44,13 @@ def _dirichlet(part, D, u_D):
 
 def _lifted(K, rhs, rows, values, part):
     """``K`` and ``rhs`` with the identity at ``rows``, ``values`` lifted
-    (in place; returns the vector of prescribed values)."""
+    (in place)."""
     x = pt.empty_vector(part)
     if len(rows):
         x.setValues(rows, values)
     x.assemble()
     K.zeroRowsColumns(rows, diag=1.0, x=x, b=rhs)
-    return x
+    x.destroy()
 
 
 def _impose(x, rows, values):
