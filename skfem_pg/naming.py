@@ -1,7 +1,7 @@
 r"""Thesis names of formulations (Table 7.1) <-> ``FamilyBasis`` options.
 
 A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
-{formulation} [TL|UL] [noBC]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
+{formulation} [TL|UL] [noBC] [kNN]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
 ``FEM {T1|Q1|O1|H1|Q1P0|H1P0|T2|Q2|O2|H2}`` for the FE comparators:
 
 ==========  ==============================================================
@@ -23,7 +23,14 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
             ``U1SUnl`` (WTE1 at the masters, stabilized on its MTE1
             basis), ``U1SIG`` on WTE1 without bond correction
 ``TL``      total Lagrangian reference frame (the default; ``UL``, updated
-            Lagrange, is not built yet)
+            Lagrange)
+``kNN``     a package token: the ``kNN`` recipe of
+            :mod:`skfem_pg.discretization.recipes` (families of the 10
+            nearest particles, pairwise; uniform quadrature weights
+            :math:`V^k/n_k`; unit bond weights) instead of the thesis'
+            mesh families, volume weights (4.30) and
+            :math:`\omega = 1/|\Delta X|^2` — the keyword API's default
+            for PBG Unl on 3-D tetrahedra
 ==========  ==============================================================
 
 So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
@@ -58,7 +65,7 @@ FE_NAMES = ("T1", "Q1", "O1", "H1", "Q1P0", "H1P0", "T2", "Q2", "O2", "H2")
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
                    r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
-                   r"(?:\s+(?P<nobc>noBC))?$")
+                   r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN))?$")
 _BOUNDARY = {"p": "p", "s": "s", "sn": "sn", "m": "min-norm"}
 
 
@@ -137,6 +144,15 @@ def parse(name):
         raise ValueError("{!r} asks for BC and noBC".format(name))
     kw = {"shape": SHAPES[form], "method": method,
           "bond": first_order and not g["nobc"] and form not in MASTER_ONLY}
+    if g["recipe"]:
+        if method != "PBG" or SHAPES[form] != "MTE1":
+            raise ValueError("{!r}: the kNN recipe (uniform quadrature "
+                             "weights) is for PBG on MTE1 bases".format(name))
+        kw.update(families="nearest", weights="uniform", weight_exponent=0)
+    else:  # the thesis' families (WTE2: its horizon) and weights
+        if SHAPES[form] != "WTE2":
+            kw["families"] = "mesh"
+        kw.update(weights="volume", weight_exponent=1)
     notes = []
     if g["vc"] is None:
         if g["variant"] or g["boundary"]:
@@ -183,4 +199,6 @@ def name_of(basis):
     if vc:
         variant += {v: k for k, v in _BOUNDARY.items()}[basis.vc_boundary]
     tail = " noBC" if first_order and not basis.bond else ""
+    if getattr(basis, "recipe", None) == "kNN":
+        tail += " kNN"
     return "{}{}{} {} TL{}".format(prefix, method, variant, form, tail)

@@ -4,7 +4,7 @@ import pytest
 
 import skfem_pg as pg
 from skfem_pg.naming import fe_method, formulation_of, parse
-from conftest import square
+from conftest import cube, square
 
 
 @pytest.mark.parametrize("name, expected", [
@@ -38,7 +38,27 @@ from conftest import square
 ])
 def test_parse(name, expected):
     kw, _ = parse(name)
-    assert kw == expected
+    # thesis names keep the thesis' families and quadrature weights
+    thesis = {"weights": "volume", "weight_exponent": 1}
+    if expected["shape"] != "WTE2":  # WTE2: its own horizon
+        thesis["families"] = "mesh"
+    assert kw == {**expected, **thesis}
+
+
+def test_knn_token_names_the_package_recipe():
+    kw, _ = parse("VCBCPBG V5m Unl TL kNN")
+    assert kw["families"] == "nearest" and kw["weights"] == "uniform" \
+        and kw["weight_exponent"] == 0
+    for bad in ("VCPPG V3m Unl kNN", "VCPBG U2 kNN"):
+        with pytest.raises(ValueError, match="kNN"):
+            parse(bad)
+    tets = pg.Particles.from_mesh(cube(3, 0.2, seed=2, kind="tet"))
+    b = pg.FamilyBasis(tets, dim=3)  # the keyword default on tetrahedra
+    assert b.recipe == "kNN" and b.name == "VCBCPBG V5m Unl TL kNN"
+    assert pg.FamilyBasis.from_name(tets, b.name, dim=3).recipe == "kNN"
+    thesis = pg.FamilyBasis.from_name(tets, "VCBCPBG V5m Unl", dim=3)
+    assert thesis.recipe == "mesh" and thesis.name == "VCBCPBG V5m Unl TL"
+    assert thesis.weights == "volume" and thesis.weight_exponent == 1
 
 
 def test_round_trip_writes_the_full_code():

@@ -7,8 +7,14 @@ from skfem_pg import threads
 
 
 def _blas_threads():
+    """Threads of the BLAS libraries the kernels limit: those loaded when
+    the first kernel ran (NumPy's); a BLAS loaded later by another package
+    (MKL with pypardiso, whose PARDISO keeps its threads) is not
+    limited."""
+    mine = {c.filepath for c in threads._limiter().lib_controllers
+            if c.user_api == "blas"}
     return [i["num_threads"] for i in threadpool_info()
-            if i["user_api"] == "blas"]
+            if i["user_api"] == "blas" and i["filepath"] in mine]
 
 
 def test_kernels_limit_blas_threads_and_restore_them():

@@ -45,11 +45,13 @@ from skfem.element import DiscreteField
 
 from . import families as families_mod
 from . import petrov
+from . import recipes
 from .corrections import (bond_correction, check_correction,
                           correction_functions, family_radii, vc_correction)
 from ..dofs import as_dofs
 from ..errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
+from .quadrature import family_weights, volume_weights
 from .shape import GRADIENTS
 from ..threads import kernel
 from .shape.least_squares import (mls1_master_gradients,
@@ -67,14 +69,9 @@ LS_TEST_GRADIENTS = {"WLS1": wls1_master_gradients,
 TEST_SHAPES = ("master", "WTE1", "WLS1", "WLS2", "MLS1", "LME")
 
 
-def pbg_weights(volumes, families):
-    """PBG quadrature weights :math:`w_{kj} = V^k V^j / V_H^k` (4.30),
-    ``(nf, m)``, zero in padded slots; they sum to :math:`V^k` per
-    family."""
-    mem, mask = families.padded()
-    Vm = volumes[mem] * mask
-    return volumes[families.masters][:, None] * Vm / Vm.sum(axis=1,
-                                                           keepdims=True)
+#: PBG quadrature weights :math:`w_{kj} = V^k V^j / V_H^k` (4.30), the
+#: thesis' rule (:func:`~skfem_pg.discretization.quadrature.volume_weights`)
+pbg_weights = volume_weights
 
 
 class FamilyBasis(AbstractBasis):
@@ -86,10 +83,22 @@ class FamilyBasis(AbstractBasis):
         :class:`~skfem_pg.Particles`, or a scikit-fem mesh (its vertices
         become particles, :meth:`Particles.from_mesh`).
     families
-        :class:`~skfem_pg.discretization.families.Families`; default: mesh
-        connectivity (``families.from_mesh``) for mesh particles, otherwise a
-        horizon of 1.51 h; for WTE2 a horizon of 2.51 h, small families
-        enlarged to one member more than the quadratic basis needs.
+        :class:`~skfem_pg.discretization.families.Families`, or a rule of
+        :data:`~skfem_pg.discretization.families.RULES`: ``"mesh"`` (mesh
+        connectivity), ``"nearest"`` (the 10 (3-D) / 6 (2-D) nearest
+        particles, pairwise) or ``"horizon"`` (1.51 h).  Default: the
+        recipe of :mod:`~skfem_pg.discretization.recipes` — ``"nearest"``
+        for PBG MTE1 on 3-D tetrahedra (recipe ``kNN``), else ``"mesh"``
+        for mesh particles and a horizon of 1.51 h otherwise; for WTE2 a
+        horizon of 2.51 h, small families enlarged to one member more
+        than the quadratic basis needs.
+    weights
+        PBG quadrature weights
+        (:mod:`~skfem_pg.discretization.quadrature`): ``"volume"``
+        (:math:`V^k V^j / V_H^k`, (4.30)) or ``"uniform"``
+        (:math:`V^k / n_k`).  Default (``"auto"``): the recipe's —
+        ``"uniform"`` with ``"nearest"`` families, else ``"volume"``.
+        PPG has its own weights (:math:`V^j`).
     shape
         ``"MTE1"`` (moving Taylor expansion, formulation Unl; default),
         ``"WTE1"`` (static Taylor expansion = classical correspondence,
@@ -123,7 +132,9 @@ class FamilyBasis(AbstractBasis):
         Number of field components: ``None`` for a scalar field (e.g.
         Poisson), the spatial dimension for displacements.
     weight_exponent
-        ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}` (default 1).
+        ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}`, ``n >= 0``.
+        Default (``"auto"``): the recipe's — 0 with ``"nearest"``
+        families, else 1.
     vc_solver
         Solver of the VC constraint system: ``"auto"`` (``"direct"``, in
         3-D above 15k particles ``"amg"``), ``"direct"`` (scalar sparse
@@ -201,10 +212,10 @@ class FamilyBasis(AbstractBasis):
 
     @kernel
     def __init__(self, particles, families=None, shape="MTE1", bond=None,
-                 vc="auto", method="PBG", dim=None, weight_exponent=1,
+                 vc="auto", method="PBG", dim=None, weight_exponent="auto",
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
                  test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
-                 vc_tolerance=1e-8, distributed=None):
+                 vc_tolerance=1e-8, distributed=None, weights="auto"):
         if isinstance(particles, fem.Mesh):
             particles = Particles.from_mesh(particles)
         if not isinstance(particles, Particles):
@@ -257,14 +268,39 @@ class FamilyBasis(AbstractBasis):
                 "the VC correction needs surface area vectors A^i: these "
                 "particles have no mesh, so pass area_vectors= (shape "
                 "(dim, n)) or use vc=None")
+        if ppg and weights not in ("auto", None, "volume"):
+            raise ValueError("weights={!r} is a PBG option: PPG integrates "
+                             "with the member volumes V^j".format(weights))
+        t_families = time.perf_counter()
+        if families is None and shape == "WTE2":
+            # twice the d + d(d+1)/2 quadratic moments, plus the master:
+            # with fewer, corner families of graded meshes (Cook's (48,
+            # 60) at 7 members) give a singular WTE2 moment matrix
+            d = particles.dim
+            families = families_mod.horizon(
+                particles, factor=2.51,
+                min_size=1 + 2 * (d + d * (d + 1) // 2))
+        elif families is None and particles.mesh is None:
+            families = "horizon"
+        families, weights, weight_exponent, self.recipe = recipes.resolve(
+            particles, families, weights, weight_exponent, method, shape)
+        weight_exponent = recipes.check_exponent(weight_exponent)
+        if weights not in ("volume", "uniform"):
+            raise ValueError("weights must be 'auto', 'volume' or "
+                             "'uniform', got {!r}".format(weights))
         self.particles = particles
         self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
-        # what rebuilds this basis on moved particles (updated Lagrange)
+        self.weights = weights
+        # what rebuilds this basis on moved particles (updated Lagrange):
+        # the family rule, not the families
         self.options = dict(
             shape=shape, bond=bond, vc=vc, method=method, dim=dim,
             weight_exponent=weight_exponent, vc_solver=vc_solver,
             vc_exclude=vc_exclude, test_shape=test_shape, lme_mu=lme_mu,
-            vc_boundary=vc_boundary, vc_tolerance=vc_tolerance)
+            vc_boundary=vc_boundary, vc_tolerance=vc_tolerance,
+            weights=weights)
+        if isinstance(families, str):
+            self.options["families"] = families
         self.test_shape = test_shape
         self.distributed = distributed
         self._vc_correct = vc_correct = (
@@ -275,19 +311,9 @@ class FamilyBasis(AbstractBasis):
         x, V = particles.x, particles.volumes
         sdim = particles.dim
 
-        t0 = time.perf_counter()
-        if families is None and shape == "WTE2":
-            # twice the d + d(d+1)/2 quadratic moments, plus the master:
-            # with fewer, corner families of graded meshes (Cook's (48,
-            # 60) at 7 members) give a singular WTE2 moment matrix
-            d = particles.dim
-            families = families_mod.horizon(
-                particles, factor=2.51,
-                min_size=1 + 2 * (d + d * (d + 1) // 2))
-        elif families is None:
-            families = (families_mod.from_mesh(particles)
-                        if particles.mesh is not None
-                        else families_mod.horizon(particles))
+        t0 = t_families
+        if isinstance(families, str):
+            families = families_mod.build(families, particles)
         if ppg and distributed is None:  # a partition's come complete
             families = petrov.pairwise(families)
         self.families = families
@@ -335,7 +361,7 @@ class FamilyBasis(AbstractBasis):
                 dx_t = np.zeros_like(Vm)
                 dx_t[:, 0] = V[families.masters]
             else:
-                self.dx = pbg_weights(V, families)
+                self.dx = family_weights(weights, V, families)
             if vc is not None:
                 t0 = time.perf_counter()
                 area_vectors = self._area_vectors(area_vectors)
@@ -442,7 +468,12 @@ class FamilyBasis(AbstractBasis):
         :mod:`skfem_pg.naming`."""
         from ..naming import parse
         kw, notes = parse(name)
-        basis = cls(particles, families, **{**kw, **kwargs})
+        if (isinstance(particles, Particles) and particles.mesh is None
+                and kw.get("families") == "mesh"):
+            kw["families"] = "horizon"  # the thesis' rule without a mesh
+        if families is not None:
+            kw["families"] = families
+        basis = cls(particles, **{**kw, **kwargs})
         basis.name_notes = notes
         return basis
 
@@ -480,7 +511,7 @@ class FamilyBasis(AbstractBasis):
             t0 = time.perf_counter()
             Gs = [bond_correction(G, x, f) for G, f in zip(Gs, subs)]
             self.timings["bond"] = time.perf_counter() - t0
-        dxs = [pbg_weights(V, f) for f in subs]
+        dxs = [family_weights(self.weights, V, f) for f in subs]
         flat = np.empty(L.n_points)
         for g, d in zip(L, dxs):
             flat[g.flat] = d

@@ -18,6 +18,9 @@ Builders
     The ``n`` nearest particles, with pairwise completion (``j`` joins
     :math:`H^k` whenever ``k`` is in :math:`H^j`).
 
+:data:`RULES` names them for :class:`~skfem_pg.FamilyBasis`
+(``families="nearest"``) and :mod:`~skfem_pg.discretization.recipes`.
+
 Every builder enlarges families that are too small, or whose non-master
 members do not span the space (collinear in 2-D, coplanar in 3-D), by the
 next ring of neighbours: MLS1 at the master, needed by the VC correction,
@@ -343,4 +346,29 @@ def check_supports(particles, families, n_required, what):
                     families.sizes[k], what, n_required, len(small)))
 
 
-__all__ = ["Families", "from_mesh", "horizon", "nearest", "check_supports"]
+def _nearest_default(particles):
+    from .recipes import NEAREST
+    return nearest(particles, NEAREST[particles.dim])
+
+
+#: family rules by name: ``rule(particles) -> Families`` with the rule's
+#: default parameters (``"nearest"``: :data:`~skfem_pg.discretization.
+#: recipes.NEAREST` neighbours, pairwise)
+RULES = {"mesh": from_mesh, "nearest": _nearest_default, "horizon": horizon}
+
+
+def build(rule, particles):
+    """The families of rule ``rule`` (a name of :data:`RULES`) on
+    ``particles``; ``"mesh"`` on particles without a mesh raises
+    :class:`FamilyError`."""
+    try:
+        f = RULES[rule]
+    except (KeyError, TypeError):
+        raise FamilyError("unknown family rule {!r}: one of {}, or a "
+                          "Families object".format(
+                              rule, ", ".join(map(repr, RULES)))) from None
+    return f(particles)
+
+
+__all__ = ["Families", "RULES", "build", "from_mesh", "horizon", "nearest",
+           "check_supports"]

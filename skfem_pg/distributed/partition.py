@@ -251,6 +251,17 @@ class Partition:
             raise NotImplementedError(
                 "vc={!r} on MPI: the distributed VC solve takes V3, V5 or "
                 "None".format(options["vc"]))
+        if isinstance(families, str):  # a rule (thesis names: "mesh")
+            if families != "mesh":
+                raise NotImplementedError(
+                    "families={!r} on MPI: a rank builds its families from "
+                    "the mesh (rule 'mesh') or takes them given".format(
+                        families))
+            families = None
+        if options.get("weights", "volume") not in ("auto", "volume"):
+            raise NotImplementedError(
+                "weights={!r} on MPI: the distributed basis integrates with "
+                "the volume weights (4.30)".format(options["weights"]))
         fam = (self.families(pairwise=method == "PPG1") if families is None
                else families)
         if np.any(self.owner[fam.masters] != self.rank):

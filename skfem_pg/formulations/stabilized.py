@@ -140,7 +140,8 @@ def under_integrated(basis):
                        shape="WTE1", bond=False,
                        vc=None if basis.vc is None else "V3",
                        vc_boundary=basis.vc_boundary, dim=basis.ncomp,
-                       weight_exponent=basis.weight_exponent)
+                       weight_exponent=basis.weight_exponent,
+                       weights=basis.weights)
 
 
 class _MasterModel(Hyperelastic):

@@ -47,11 +47,11 @@ def pardiso_available():
 def direct(A, b, ordering="auto", **kwargs):
     """Sparse direct solve for FE and PG systems alike.
 
-    ``ordering="auto"``: MKL PARDISO if ``pypardiso`` is installed (3-D
-    Cook tetrahedra, 11k unknowns: PG 1.3 s against 5.0 s for SuperLU
-    with COLAMD, O1 0.33 s against 1.4 s; benchmarks/README.md), else
-    ``"rcm+mmd"``.  ``"pardiso"``: MKL PARDISO (its own nested-dissection
-    ordering, MKL's threads).  ``ordering="rcm+mmd"``: reverse
+    ``ordering="auto"``: MKL PARDISO if ``pypardiso`` is installed
+    (benchmarks/README.md), else ``"rcm+mmd"``.  ``"pardiso"``: MKL
+    PARDISO (its own nested-dissection ordering, MKL's threads); a
+    symmetric matrix in its symmetric indefinite mode on the upper
+    triangle (LDL^T), a non-symmetric one by LU.  ``ordering="rcm+mmd"``: reverse
     Cuthill–McKee permutation, then SuperLU's ``MMD_AT_PLUS_A``; measured
     on 14k–80k dof 2-D elasticity systems (gmsh triangles, distorted
     grids; T1/Q1 and PG) the fastest of scipy's options or within 1.3x of
@@ -75,10 +75,7 @@ def direct(A, b, ordering="auto", **kwargs):
     if ordering == "auto":
         ordering = "pardiso" if pardiso_available() else "rcm+mmd"
     if ordering == "pardiso":
-        import pypardiso
-        x = pypardiso.spsolve(A, b)
-        pypardiso.ps.free_memory(everything=True)
-        return x
+        return _pardiso(A, b)
     if ordering == "rcm+mmd" and np.any(A.diagonal() == 0.0):
         ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
     if ordering == "colamd":
@@ -104,6 +101,23 @@ def direct(A, b, ordering="auto", **kwargs):
         x[p] = xp
         return x
     x[p] = spl.spsolve(Ap, bp, permc_spec="MMD_AT_PLUS_A")
+    return x
+
+
+def _pardiso(A, b):
+    """MKL PARDISO: a symmetric matrix as real symmetric indefinite
+    (``mtype=-2``, LDL^T with Bunch–Kaufman pivoting, the upper triangle
+    only: half the fill of the LU mode, and PG's indefinite late Newton
+    tangents solve too), otherwise LU (``mtype=11``)."""
+    import pypardiso
+    import scipy.sparse as sp
+    if _symmetric(A):
+        solver = pypardiso.PyPardisoSolver(mtype=-2)
+        x = solver.solve(sp.triu(A, format="csr"), b)
+    else:
+        solver = pypardiso.PyPardisoSolver(mtype=11)
+        x = solver.solve(A, b)
+    solver.free_memory(everything=True)
     return x
 
 
