@@ -312,7 +312,8 @@ def test_line_search_tames_an_oscillating_newton(max_x):
     assert all(b <= a for a, b in zip(r[1:], r[2:]))  # after the first
 
 
-@pytest.mark.parametrize("kind", ["spd", "indefinite", "nonsymmetric"])
+@pytest.mark.parametrize("kind", ["spd", "indefinite", "saddle",
+                                  "nonsymmetric"])
 def test_pardiso_symmetric_mode_equals_superlu(kind):
     """With pypardiso installed, symmetric matrices go to PARDISO's
     symmetric indefinite mode (upper triangle, LDL^T), others to its LU:
@@ -330,6 +331,9 @@ def test_pardiso_symmetric_mode_equals_superlu(kind):
     if kind == "nonsymmetric":
         A = (A + 1e-2 * sp.random(*A.shape, density=0.01,
                                   random_state=rng)).tocsr()
+    if kind == "saddle":  # zero diagonal block: stored zeros for PARDISO
+        B = sp.random(10, A.shape[0], density=0.3, random_state=rng)
+        A = sp.bmat([[A, B.T], [B, None]]).tocsr()
     b = rng.standard_normal(A.shape[0])
     x = pg.solvers.direct(A, b, ordering="pardiso")
     y = pg.solvers.direct(A, b, ordering="rcm+mmd")

@@ -6,7 +6,11 @@ systems.
 =====================  ====================================================
 ``particles``          particles collocated from meshes (volumes, area
                        vectors, fold and inversion checks)
-``families``           family builders (mesh connectivity, horizons)
+``families``           family builders (mesh connectivity, horizons,
+                       nearest neighbours) and their rule names
+``recipes``            which families, quadrature and bond weights a
+                       basis uses by default (thesis' or kNN)
+``quadrature``         PBG quadrature weights (volume (4.30), uniform)
 ``shape``              WTE1/MTE1, WTE2, least-squares and LME derivatives
 ``corrections``        bond (5.55) and VC (5.57)–(5.64) corrections;
                        ``vc_boundary``, ``vc2``: boundary variants, VC2

@@ -27,20 +27,23 @@ recipe     families, weights, exponent                 default for
 Why ``kNN`` on tetrahedra.  A gmsh tetrahedral mesh gives a vertex 14
 neighbours on average and as many as 30, spread over the cells around it;
 the 1-ring family, weighted by member volumes, averages the strain energy
-of a bending field over a region reaching far beyond the master, and
-VC PBG Unl is soft: on the linear 3-D Cook's membrane its corner error is
-+15 / +25 / +19 / +13 / +9.5 % at 615 / 1343 / 2254 / 4038 / 6813 nodes
-(O1: −30 / −18 / −14 / −8.9 / −6.4 %, against a Richardson-extrapolated
-H2 reference).  The nearest ten particles are the compact neighbourhood
-the moving Taylor expansion needs (at least nine others in general
-position, pairwise completion adds two on average); uniform weights keep
-the energy at the family instead of on its largest (farthest) members,
-and unit bond weights use the few members evenly.  The result converges
-from below like FE, with the error of a much finer O1 mesh: −18 / −3.4 /
-−0.3 / −0.1 % on the same node sets (0.03× O1's error at 4038 nodes,
-``benchmarks/README.md``).  On hexahedral grids (at most 27 regularly
-placed members) and in 2-D the thesis rule is already more accurate and
-stays the default.
+of a bending field over a region reaching far beyond the master
+(:mod:`~skfem_pg.discretization.quadrature`), and VC PBG Unl is soft: on
+the linear 3-D Cook's membrane its corner error is +15 / +25 / +19 / +13 /
++9.2 % at 615 / 1343 / 2254 / 4038 / 6813 nodes (O1: −30 / −18 / −14 /
+−8.8 / −6.3 %; against an O2 overkill on 25.5k nodes, itself within about
+0.1 %).  The nearest ten particles are the compact neighbourhood the
+moving Taylor expansion needs (at least nine others in general position;
+pairwise completion adds two on average); uniform weights keep the energy
+at the family instead of on its largest (farthest) members, and unit bond
+weights use the few members evenly.  Each choice alone helps little
+(uniform weights on 1-ring families: +7.8 % at 2254 nodes; ten nearest
+with volume weights: +5.1 %, stalling there); together they converge from
+below like FE: −18 / −3.1 / −1.7 / +0.4 / −0.03 % on the same node sets
+(the tables ``recipes_3d_*`` in ``benchmarks/README.md``, written by
+``benchmarks/recipes_3d.py``).  On hexahedral grids (at most 27 regularly
+placed members) and in 2-D the thesis recipe is more accurate and stays
+the default.
 
 The Table 7.1 names mean what the thesis means (``mesh``);
 the package token ``kNN`` at the end of a name selects this recipe

@@ -388,7 +388,7 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
 def geo_path(name):
     """Path of a ``.geo`` file shipped with the package
     (``skfem_pg/scenes/meshes/``: cook.geo, cook3d.geo, cube.geo,
-    square.geo)."""
+    square.geo, beam3d.geo, plate_hole3d.geo)."""
     here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "meshes")
     fn = os.path.join(here, name)
     if not os.path.isfile(fn):

@@ -112,8 +112,15 @@ def _pardiso(A, b):
     import pypardiso
     import scipy.sparse as sp
     if _symmetric(A):
+        # the upper triangle with every diagonal entry stored (PARDISO's
+        # symmetric modes need them; a saddle point's are zero)
+        U = sp.triu(A, format="coo")
+        n = A.shape[0]
+        U = sp.csr_matrix((np.r_[U.data, np.zeros(n)],
+                           (np.r_[U.row, np.arange(n)],
+                            np.r_[U.col, np.arange(n)])), shape=A.shape)
         solver = pypardiso.PyPardisoSolver(mtype=-2)
-        x = solver.solve(sp.triu(A, format="csr"), b)
+        x = solver.solve(U, b)
     else:
         solver = pypardiso.PyPardisoSolver(mtype=11)
         x = solver.solve(A, b)
