@@ -120,14 +120,14 @@ def test_unpadded_pipeline_equals_padded(boundary, families):
     same kernels on the padded arrays give the same derivatives."""
     from skfem_pg.discretization.corrections import (
         bond_correction, correction_functions, vc_correction)
-    from skfem_pg.discretization.quadrature import family_weights
+    from skfem_pg.discretization.quadrature import weight_rule
     from skfem_pg.discretization.shape import GRADIENTS
     p = pg.Particles.from_mesh(cube(3, 0.3, kind="tet"))
     b = pg.FamilyBasis(p, dim=3, vc_boundary=boundary, families=families)
     assert b._G is None and len(b.layout) > 1  # built without padding
     fam, x, V, n = b.families, p.x, p.volumes, b.weight_exponent
     G = bond_correction(GRADIENTS["MTE1"](x, V, fam, n=n), x, fam)
-    dx = family_weights(b.weights, V, fam)
+    dx = weight_rule(b.weights)(V, fam)
     Gc, rep = vc_correction(G, dx, x, V, fam, p.area_vectors(),
                             correction_functions("V5", x, V, fam, n=n),
                             boundary=boundary,

@@ -51,7 +51,7 @@ from .corrections import (bond_correction, check_correction,
 from ..dofs import as_dofs
 from ..errors import FamilyError, SlowAssemblyWarning, describe_particle
 from .particles import Particles, linear_elements
-from .quadrature import family_weights, volume_weights
+from .quadrature import volume_weights, weight_rule
 from .shape import GRADIENTS
 from ..threads import kernel
 from .shape.least_squares import (mls1_master_gradients,
@@ -285,9 +285,7 @@ class FamilyBasis(AbstractBasis):
         families, weights, weight_exponent, self.recipe = recipes.resolve(
             particles, families, weights, weight_exponent, method, shape)
         weight_exponent = recipes.check_exponent(weight_exponent)
-        if weights not in ("volume", "uniform"):
-            raise ValueError("weights must be 'auto', 'volume' or "
-                             "'uniform', got {!r}".format(weights))
+        self._weigh = weight_rule(weights)
         self.particles = particles
         self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
         self.weights = weights
@@ -361,7 +359,7 @@ class FamilyBasis(AbstractBasis):
                 dx_t = np.zeros_like(Vm)
                 dx_t[:, 0] = V[families.masters]
             else:
-                self.dx = family_weights(weights, V, families)
+                self.dx = self._weigh(V, families)
             if vc is not None:
                 t0 = time.perf_counter()
                 area_vectors = self._area_vectors(area_vectors)
@@ -511,7 +509,7 @@ class FamilyBasis(AbstractBasis):
             t0 = time.perf_counter()
             Gs = [bond_correction(G, x, f) for G, f in zip(Gs, subs)]
             self.timings["bond"] = time.perf_counter() - t0
-        dxs = [family_weights(self.weights, V, f) for f in subs]
+        dxs = [self._weigh(V, f) for f in subs]
         flat = np.empty(L.n_points)
         for g, d in zip(L, dxs):
             flat[g.flat] = d

@@ -346,14 +346,18 @@ def check_supports(particles, families, n_required, what):
                     families.sizes[k], what, n_required, len(small)))
 
 
+#: neighbours of the ``"nearest"`` rule by spatial dimension (3-D: the
+#: kNN recipe, :mod:`skfem_pg.discretization.recipes`)
+NEAREST = {1: 2, 2: 6, 3: 10}
+
+
 def _nearest_default(particles):
-    from .recipes import NEAREST
     return nearest(particles, NEAREST[particles.dim])
 
 
 #: family rules by name: ``rule(particles) -> Families`` with the rule's
-#: default parameters (``"nearest"``: :data:`~skfem_pg.discretization.
-#: recipes.NEAREST` neighbours, pairwise)
+#: default parameters (``"nearest"``: :data:`NEAREST` neighbours,
+#: pairwise)
 RULES = {"mesh": from_mesh, "nearest": _nearest_default, "horizon": horizon}
 
 
@@ -370,5 +374,5 @@ def build(rule, particles):
     return f(particles)
 
 
-__all__ = ["Families", "RULES", "build", "from_mesh", "horizon", "nearest",
+__all__ = ["Families", "NEAREST", "RULES", "build", "from_mesh", "horizon", "nearest",
            "check_supports"]

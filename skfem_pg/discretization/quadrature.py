@@ -56,14 +56,14 @@ def uniform_weights(volumes, families):
 WEIGHTS = {"volume": volume_weights, "uniform": uniform_weights}
 
 
-def family_weights(rule, volumes, families):
-    """The weights of rule ``rule`` (a name of :data:`WEIGHTS`)."""
+def weight_rule(name):
+    """The weight function ``f(volumes, families)`` of rule ``name`` (a
+    name of :data:`WEIGHTS`); raises ``ValueError`` naming the choices."""
     try:
-        f = WEIGHTS[rule]
+        return WEIGHTS[name]
     except (KeyError, TypeError):
-        raise ValueError("unknown quadrature weights {!r}: one of {}".format(
-            rule, ", ".join(map(repr, WEIGHTS)))) from None
-    return f(volumes, families)
+        raise ValueError("weights must be one of {}, got {!r}".format(
+            ", ".join(map(repr, WEIGHTS)), name)) from None
 
 
-__all__ = ["WEIGHTS", "family_weights", "uniform_weights", "volume_weights"]
+__all__ = ["WEIGHTS", "weight_rule", "uniform_weights", "volume_weights"]

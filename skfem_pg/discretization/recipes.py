@@ -57,8 +57,9 @@ RECIPES = {
     "mesh": ("mesh", "volume", 1),
     "kNN": ("nearest", "uniform", 0),
 }
-#: neighbours of the ``"nearest"`` family rule by spatial dimension
-NEAREST = {1: 2, 2: 6, 3: 10}
+#: family rule -> the (weights, exponent) it comes with; other rules and
+#: given families: the thesis' ("volume", 1)
+_WITH_RULE = {rule: (w, n) for rule, w, n in RECIPES.values()}
 
 
 def default_recipe(particles, method="PBG", shape="MTE1"):
@@ -85,7 +86,7 @@ def resolve(particles, families, weights, weight_exponent, method, shape):
     if families is None:
         families = RECIPES[default_recipe(particles, method, shape)][0]
     rule = families if isinstance(families, str) else None
-    w, n = ("uniform", 0) if rule == "nearest" else ("volume", 1)
+    w, n = _WITH_RULE.get(rule, RECIPES["mesh"][1:])
     if weights in (None, "auto"):
         weights = w
     if weight_exponent in (None, "auto"):
@@ -111,5 +112,5 @@ def check_exponent(n):
     return v
 
 
-__all__ = ["RECIPES", "NEAREST", "default_recipe", "resolve",
+__all__ = ["RECIPES", "default_recipe", "resolve",
            "check_exponent"]

@@ -7,6 +7,7 @@ import time
 import warnings
 
 import numpy as np
+import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 
@@ -110,7 +111,6 @@ def _pardiso(A, b):
     only: half the fill of the LU mode, and PG's indefinite late Newton
     tangents solve too), otherwise LU (``mtype=11``)."""
     import pypardiso
-    import scipy.sparse as sp
     if _symmetric(A):
         # the upper triangle with every diagonal entry stored (PARDISO's
         # symmetric modes need them; a saddle point's are zero)
