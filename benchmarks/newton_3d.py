@@ -21,7 +21,6 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
                                 update_results)
-from skfem_pg.scenes import Scene
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")
@@ -60,7 +59,7 @@ class Timed:
         return timed
 
 
-def iterations(sc, scheme, solver, load, steps, **kw):
+def iterations(sc, scheme, solver, load, steps, candidates=None, **kw):
     """Newton's method (``skfem_pg.solvers.newton``) on the scene at
     ``load`` times its load in ``steps`` steps; per-iteration means of the
     phases (failed load steps included), the Krylov iterations per solve
@@ -71,6 +70,10 @@ def iterations(sc, scheme, solver, load, steps, **kw):
     timed = Timed(model, ("state", "internal_force", "tangent"))
     I = np.setdiff1d(np.arange(basis.N), D)
     lin = pg.solvers.static._condensed_solver(solver, basis, I)
+    if candidates is not None and hasattr(basis, "layout"):  # PG's AMG
+        lin = pg.solvers.linear_solver(
+            solver, basis.doflocs[:, I], candidates=candidates,
+            components=I % 3)
     t_lin = [0.0]
 
     def solve(A, b):
@@ -79,7 +82,8 @@ def iterations(sc, scheme, solver, load, steps, **kw):
         t_lin[0] += time.perf_counter() - t0
         return x
     t0 = time.perf_counter()
-    u, hist = pg.solvers.newton(timed, load * f, D=D, u_D=load * u_D,
+    u, hist = pg.solvers.newton(timed, load * f, D=D,
+                                u_D=lambda t: u_D(load * t),
                                 steps=steps, solver=solve, verbose=False)
     wall = time.perf_counter() - t0
     n_it = sum(len(h["residuals"]) - 1 for h in hist)
@@ -109,6 +113,11 @@ def main():
     p.add_argument("--load", type=float, default=0.25,
                    help="fraction of the Cook load (default 0.25)")
     p.add_argument("--steps", type=int, default=2)
+    p.add_argument("--section", default="newton_3d",
+                   help="benchmarks/README.md section of the table")
+    p.add_argument("--candidates", type=int, help="PG's AMG near-null-"
+                   "space candidates beyond the rigid-body modes (default: "
+                   "Newton's, skfem_pg.solvers.PG_CANDIDATES)")
     args = p.parse_args()
     print(pg.threads.describe())
     rows = []
@@ -130,7 +139,8 @@ def main():
               flush=True)
         res = {}
         for scheme in (fe, "PG"):
-            r = iterations(sc, scheme, args.solver, args.load, args.steps)
+            r = iterations(sc, scheme, args.solver, args.load, args.steps,
+                           args.candidates)
             res[scheme] = r
             print("  {:5s} {newton} Newton iterations, each: material "
                   "{material:.3f} s, assembly {assembly:.3f} s, solve "
@@ -163,20 +173,26 @@ def write(rows, args):
          "material", "assembly", "solve", "Krylov its PG / FE",
          "Newton its PG / FE", "PG preprocess [s]"],
         [[r[1], r[0]] + r[2:] for r in rows])
-    text = ("`python benchmarks/newton_3d.py --solver {s} --load {l} "
-            "--steps {n}`: `skfem_pg.solvers.newton` on the 3-D Cook's "
+    text = ("`python benchmarks/newton_3d.py --sizes {z} --hex {h} --solver "
+            "{s} --load {l} --steps {n}{c}`: `skfem_pg.solvers.newton` on the 3-D Cook's "
             "membrane of "
             "`demos/cook_3d.py` at {l} of its load in {n} load steps; PG = "
-            "VC PBG Unl on the FE mesh's nodes. Seconds per Newton "
+            "`Scene.solve(\"PG\")`'s default on the FE mesh's nodes (VC PBG "
+            "Unl kNN on tetrahedra, the thesis' VC PBG Unl on hexahedra). "
+            "Seconds per Newton "
             "iteration (failed load steps included) and the PG/FE ratios "
             "of its phases, in the same run; material = stress and "
             "tangent at the points, assembly = interpolation, internal "
             "force and tangent assembly, solve = the condensed linear "
             "solve ({t}).\n\n{tab}\n".format(
+                z=" ".join("{:g}".format(x) for x in args.sizes),
+                h=" ".join(str(x) for x in args.hex),
                 s=args.solver, l=args.load, n=args.steps,
+                c="" if args.candidates is None else
+                " --candidates {}".format(args.candidates),
                 t=pg.threads.describe(), tab=table))
     print(text)
-    update_results(RESULTS, "newton_3d", text)
+    update_results(RESULTS, args.section, text)
 
 
 if __name__ == "__main__":

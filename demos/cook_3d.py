@@ -1,6 +1,6 @@
-"""3-D Cook's membrane (thesis Fig. 7.3 / 7.21): PG against O1 on the same
-irregular tetrahedral node sets, H1P0 on distorted hexahedral grids, error
-against wall time.
+"""3-D Cook's membrane (thesis Fig. 7.3 / 7.21): time to accuracy of PG,
+O1 and O2 on the same irregular tetrahedral node sets and H1P0 on
+distorted hexahedral grids.
 
 The 2-D outline (0,0), (48,44), (48,60), (0,44) extruded by a thickness of
 10 in z (``skfem_pg/scenes/meshes/cook3d.geo``); clamped at x = 0; a dead area
@@ -9,22 +9,27 @@ thickness and material is not in the text: we use thickness 10 and the iso/vol
 neo-Hooke (2.43) with lambda = 100, mu = 40 (the 2-D Cook's constants), so
 that the mean-dilatation H1P0 applies.  The load bends the plate out of
 plane by about 40 (load steps adapt).  Quantity: z-displacement of the
-corner (48, 60, 10), against an H2 overkill on a regular 16 x 16 x 4 hex
-mesh (cached; H2 on 8 x 8 x 2 gives 40.003, 16 x 16 x 4 40.169, H1P0 on
-24 x 24 x 6 / 32 x 32 x 8 40.035 / 40.110: the reference itself is good to
-about 0.2 %).
+corner (48, 60, 10).
 
-Node sets: gmsh tetrahedra of mesh sizes ``--sizes`` (VC PBG Unl with the
-kNN recipe, the default, and with the thesis' mesh families, and BCPPG
-Unl on the vertices, O1 on the same tetrahedra); H1P0 on regular
-n x n x n/4 hex grids
-with interior nodes distorted by ±0.3h (``--hex``; tetrahedra have no
-mean-dilatation element here).  Prints errors, wall time (preprocess /
-assemble / solve), the PG/O1 deviation and time ratios; writes
-out/cook_3d.png and a VTU with von Mises stress.
+Reference: H2 on regular n x n x n/4 hex grids (cached); by default
+Richardson extrapolation from the grids 16 and 24 with the order the grids
+8 / 16 / 24 show; its own error is stated as its distance to the finer
+grid's value (``--reference 16`` takes that grid alone: quicker, good to
+about 0.3 %).
 
-    python demos/cook_3d.py [--sizes 5 3.5 2.5] [--hex 8 12 16]
-        [--methods O1 "VC PBG Unl kNN" "VC PBG Unl" "BCPPG Unl"]
+Methods (``--methods``) on gmsh tetrahedra of mesh sizes ``--sizes``: O1
+and O2 (what an FE user picks for bending), VC PBG Unl with the kNN recipe
+(the default on tetrahedra) and with the thesis' mesh families, and
+BCPPG Unl (not run by default); H1P0 on n x n x n/4 hex grids with interior
+nodes distorted by +-0.3h (``--hex``; tetrahedra have no mean-dilatation
+element here).  Prints errors, wall time (preprocess / assemble / solve),
+each method's time to 1 % and 0.3 %, the PG/O1 deviation and time ratios
+of Fig. 7.21; writes out/cook_3d.png (error against nodes and against wall
+time) and a VTU with von Mises stress.
+
+    python demos/cook_3d.py [--sizes 3.5 2.5 2 1.6 1.3] [--hex 8 12 16 24]
+        [--methods O1 O2 "VC PBG Unl kNN" "VC PBG Unl" "BCPPG Unl"]
+        [--reference 16 24]
 """
 import os
 
@@ -32,9 +37,11 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes.reference import overkill
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
-                                print_time_to_target, save_error_vs_time,
-                                update_results, wall_time)
+from skfem_pg.scenes.reporting import (demo_parser, first_within,
+                                       markdown_table,
+                                       new_figure, output_dir,
+                                       plot_error_vs_time, save_figure,
+                                       update_results, wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -44,13 +51,21 @@ MATERIAL = mat.NeoHookeIsoVol.from_lame(100.0, 40.0)
 #: on the tetrahedral node sets; BCPPG Unl: Petrov–Galerkin with bond
 #: correction and no VC (VC PPG is unstable on 3-D tets, see README)
 METHODS = {"O1": {"scheme": "O1"},
+           "O2": {"scheme": "O2"},
            # the default on tetrahedra: nearest-neighbour families, uniform
            # weights (skfem_pg.discretization.recipes)
            "VC PBG Unl kNN": {"scheme": "PG"},
            # the thesis' recipe: mesh families, volume weights
            "VC PBG Unl": {"scheme": "PG", "families": "mesh"},
            "BCPPG Unl": {"scheme": "PG", "method": "PPG1", "vc": None}}
-STYLES = {"O1": "k--o", "H1P0": "k-s", "VC PBG Unl": "C0-D",
+#: run unless --methods says otherwise
+DEFAULT_METHODS = ("O1", "O2", "VC PBG Unl kNN", "VC PBG Unl")
+#: the accuracies whose wall time the demo reports
+TARGETS = (0.01, 0.003)
+#: a method whose error is below this fraction of the finest target skips
+#: the finer node sets (a scene computes only what it needs)
+SETTLED = 1.0 / 3.0
+STYLES = {"O1": "k--o", "O2": "k:^", "H1P0": "k-s", "VC PBG Unl": "C0-D",
           "VC PBG Unl kNN": "C2-v", "BCPPG Unl": "C1-s"}
 
 
@@ -78,86 +93,162 @@ def run(sc, name, kw, label, w_ref, rows):
     return r
 
 
-def main(sizes=(5, 3.5, 2.5), hexes=(8, 12, 16), results=None,
-         methods=None, section=None):
+def reference(grids):
+    """``(w, own error, text)``: the H2 overkill on the hex grid ``grids[0]``,
+    or Richardson extrapolation from the last two of ``grids`` with the
+    order the coarser grid 8 and those two show."""
+    def w_on(n):
+        sc = scene(cook3d(n, max(1, n // 4)))
+        return overkill(sc, refine=0, method="H2").probes["corner"][2]
+    if len(grids) == 1:
+        w = w_on(grids[0])
+        return w, None, "H2 on {0} x {0} x {1}: w = {2:.5f}".format(
+            grids[0], grids[0] // 4, w)
+    if len(grids) != 2 or grids[0] <= 8:
+        raise SystemExit("--reference: one hex grid, or two finer than 8 "
+                         "(got {})".format(grids))
+    (n1, n2), ws = grids, [w_on(n) for n in (8,) + tuple(grids)]
+    # w_n = w + C n^-p: the order from three grids (bisection on p)
+    d1, d2 = ws[1] - ws[0], ws[2] - ws[1]
+    if d1 == 0.0 or d2 / d1 <= 0.0:
+        raise SystemExit("the H2 overkills on 8 / {} / {} ({}) are not "
+                         "monotone: no Richardson extrapolation; use "
+                         "--reference {}".format(n1, n2, ws, n2))
+
+    def ratio(p):  # (n1^-p - n2^-p) / (8^-p - n1^-p)
+        return (n1 ** -p - n2 ** -p) / (8.0 ** -p - n1 ** -p)
+    lo, hi = 0.1, 8.0
+    if not ratio(hi) < d2 / d1 < ratio(lo):
+        raise SystemExit("the H2 overkills on 8 / {} / {} ({}) show no "
+                         "order in (0.1, 8); use --reference {}".format(
+                             n1, n2, ws, n2))
+    for _ in range(60):
+        p = 0.5 * (lo + hi)
+        lo, hi = (p, hi) if ratio(p) > d2 / d1 else (lo, p)
+    w = ws[2] + d2 / ((n2 / n1) ** p - 1.0)
+    return w, abs(w - ws[2]) / abs(w), (
+        "H2 on 8 / {} / {} hex grids: w = {:.5f} / {:.5f} / {:.5f}, order "
+        "{:.2f}; Richardson w = {:.5f} ({:.2%} from the {} grid's)".format(
+            n1, n2, *ws, p, w, abs(w / ws[2] - 1.0), n2))
+
+
+def main(sizes=(3.5, 2.5, 2.0, 1.6, 1.3), hexes=(8, 12, 16, 24), results=None,
+         methods=DEFAULT_METHODS, section=None, grids=(16, 24)):
     global METHODS
-    if methods:
-        unknown = set(methods) - set(METHODS)
-        if unknown or "O1" not in methods:
-            raise SystemExit("--methods: O1 and any of {} (got {})".format(
-                ", ".join(m for m in METHODS if m != "O1"), methods))
-        METHODS = {m: METHODS[m] for m in METHODS if m in methods}
+    unknown = set(methods) - set(METHODS)
+    if unknown or "O1" not in methods:
+        raise SystemExit("--methods: O1 and any of {} (got {})".format(
+            ", ".join(m for m in METHODS if m != "O1"), methods))
+    METHODS = {m: METHODS[m] for m in METHODS if m in methods}
     print(pg.threads.describe())
-    ref = overkill(scene(cook3d(16, 4)), refine=0, method="H2")
-    w_ref = ref.probes["corner"][2]
-    print("3-D Cook's membrane, q = {} in z, thickness {}; H2 overkill "
-          "(16x16x4): w{} = {:.5f}".format(Q, T, CORNER, w_ref))
+    w_ref, ref_err, ref_text = reference(tuple(grids))
+    print("3-D Cook's membrane, q = {} in z, thickness {}; reference: {}"
+          .format(Q, T, ref_text))
     rows, last = [], None
     geo = pg.meshing.geo_path("cook3d.geo")
+    done = set()  # methods already well within the finest target
     for s in sizes:
         sc = scene(pg.meshing.from_geo(geo, size=s))
         for name, kw in METHODS.items():
-            r = run(sc, name, kw, "tet {}".format(s), w_ref, rows)
+            if name in done:
+                continue
+            r = run(sc, name, kw, "tet {:g}".format(s), w_ref, rows)
             last = r if name == "VC PBG Unl kNN" else last
+            if rows[-1]["err"] < SETTLED * TARGETS[-1] and name != "O1":
+                print("  {} within {:g} %: its finer node sets are "
+                      "skipped".format(name, 100 * SETTLED * TARGETS[-1]))
+                done.add(name)
     for n in hexes:
         run(scene(cook3d(n, max(1, n // 4), 0.3, seed=n)), "H1P0",
             {"scheme": "H1P0"}, "hex {}".format(n), w_ref, rows)
-    print("\n{:>6s} {:11s} {:>9s} {:>9s} {:>6s} {:>7s} {:>7s} {:>7s}".format(
+        if rows[-1]["err"] < SETTLED * TARGETS[-1]:
+            break
+    print("\n{:>6s} {:14s} {:>9s} {:>9s} {:>6s} {:>7s} {:>7s} {:>7s}".format(
         "nodes", "method", "w", "rel.err", "steps", "pre[s]", "asm[s]",
         "slv[s]"))
     for r in rows:
-        print("{nodes:6d} {method:11s} {w:9.5f} {err:9.2e} {steps:6d} "
+        print("{nodes:6d} {method:14s} {w:9.5f} {err:9.2e} {steps:6d} "
               "{preprocess:7.3f} {assemble:7.3f} {solve:7.3f}".format(**r))
-    print("\nper tetrahedral node set: PG deviation / O1 deviation, PG time "
-          "/ O1 time (thesis at 1.2 M dof: 0.23, 1.56)")
+    print("\nFig. 7.21 per tetrahedral node set: deviation / O1's, wall time "
+          "/ O1's (thesis at 1.2 M dof, VC PBG Unl: 0.23, 1.56)")
     for s in sizes:
-        label = "tet {}".format(s)
-        sel = {r["method"]: r for r in rows if r["label"] == label}
+        sel = {r["method"]: r for r in rows
+               if r["label"] == "tet {:g}".format(s)}
         o1 = sel["O1"]
         print("  {:6d} nodes: ".format(o1["nodes"]) + ";  ".join(
             "{} {:.2f}, {:.2f}".format(name, sel[name]["err"] / o1["err"],
                                        wall_time(sel[name]) / wall_time(o1))
-            for name in METHODS if name != "O1"))
-    print_time_to_target(rows, list(METHODS) + ["H1P0"], 0.01,
-                         "corner displacement error")
+            for name in METHODS if name != "O1" and name in sel))
+    names = list(METHODS) + (["H1P0"] if hexes else [])
+    summary = []
+    for name in names:
+        hits = [first_within(rows, name, t) for t in TARGETS]
+        summary.append([name] + ["{:.1f} s ({} nodes)".format(
+            wall_time(h), h["nodes"]) if h else "not reached"
+            for h in hits])
+    head = ["method"] + ["time to {:g} %".format(100 * t) for t in TARGETS]
+    print("\nwall time of the first node set from which on the error stays "
+          "within the target:\n"
+          + markdown_table(head, summary))
     if results:
         table = [[r["nodes"], r["label"], r["method"], "{:.5f}".format(r["w"]),
                   "{:.2e}".format(r["err"]),
                   "{:.2f}".format(wall_time(r))] for r in rows]
-        subset = methods and len(METHODS) < 4
         print("updated", update_results(
-            results, section or ("cook_3d_large" if subset else "cook_3d"),
-            "`python demos/cook_3d.py --sizes {} --hex {}{}`: 3-D Cook's "
-            "membrane, iso/vol neo-Hooke, q = {} in z; H2 overkill w = "
-            "{:.5f}; corner error and wall time.\n\n".format(
+            results, section or "cook_3d",
+            "`python demos/cook_3d.py --sizes {} --hex {} --methods {} "
+            "--reference {}`: 3-D Cook's membrane, iso/vol neo-Hooke, q = {} "
+            "in z; reference {}; corner error and wall time (setup, "
+            "assembly, solve; all load steps).\n\n".format(
                 " ".join("{:g}".format(x) for x in sizes),
                 " ".join(str(n) for n in hexes),
-                " --methods " + " ".join("'{}'".format(m) for m in METHODS)
-                if subset else "", Q, w_ref)
+                " ".join("'{}'".format(m) for m in METHODS),
+                " ".join(str(n) for n in grids), Q, ref_text)
             + markdown_table(["nodes", "node set", "method", "w", "error",
-                              "wall time [s]"], table)))
-    os.makedirs(OUT, exist_ok=True)
-    save_error_vs_time(os.path.join(OUT, "cook_3d.png"), rows, STYLES,
+                              "wall time [s]"], table)
+            + "\n\nWall time of the first node set from which on the error "
+            "stays within the target:\n\n"
+            + markdown_table(head, summary)))
+    fig, (ax0, ax1) = new_figure(2, figsize=(12, 4.8))
+    for name in names:
+        sel = [r for r in rows if r["method"] == name]
+        ax0.loglog([r["nodes"] for r in sel], [r["err"] for r in sel],
+                   STYLES.get(name, "-x"), label=name)
+    for t in TARGETS:
+        ax0.axhline(t, color="0.5", lw=0.8)
+    ax0.set_xlabel("nodes")
+    ax0.set_ylabel("relative error of w(48, 60, 10)")
+    ax0.set_title("error per node")
+    ax0.grid(True, which="both", alpha=0.3)
+    ax0.legend()
+    plot_error_vs_time(ax1, rows, {n: STYLES.get(n, "-x") for n in names},
                        "relative error of w(48, 60, 10)",
-                       "3-D Cook's membrane: gmsh tetrahedra (PG, O1), "
-                       "distorted hexahedra (H1P0)")
-    pg.write_vtu(os.path.join(OUT, "cook_3d.vtu"), last.basis.particles,
-                 **particle_fields(last.basis, MATERIAL, last.u))
-    print("wrote " + OUT + "/cook_3d.png and cook_3d.vtu")
-    return rows
+                       "error against wall time", target=TARGETS[0])
+    ax1.axhline(TARGETS[1], color="0.5", lw=0.8)
+    save_figure(fig, os.path.join(OUT, "cook_3d.png"))
+    if last is not None:
+        pg.write_vtu(os.path.join(OUT, "cook_3d.vtu"), last.basis.particles,
+                     **particle_fields(last.basis, MATERIAL, last.u))
+        print("wrote " + os.path.join(OUT, "cook_3d.vtu"))
+    return rows, ref_err
 
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--sizes", type=float, nargs="+", default=[5, 3.5, 2.5],
+    ap.add_argument("--sizes", type=float, nargs="+",
+                    default=[3.5, 2.5, 2.0, 1.6, 1.3],
                     help="gmsh mesh sizes of the tetrahedral node sets")
-    ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16],
+    ap.add_argument("--hex", type=int, nargs="*", default=[8, 12, 16, 24],
                     help="H1P0 hex grids n x n x n/4")
-    ap.add_argument("--methods", nargs="+", help="subset of the tetrahedral "
-                    "methods (O1 always): e.g. --methods O1 'VC PBG Unl'")
+    ap.add_argument("--methods", nargs="+", default=list(DEFAULT_METHODS),
+                    help="the tetrahedral methods (O1 always), of: "
+                    + ", ".join(METHODS))
+    ap.add_argument("--reference", type=int, nargs="+", default=[16, 24],
+                    help="H2 hex grid(s) of the reference: one grid, or "
+                    "two for Richardson extrapolation (default 16 24)")
     ap.add_argument("--section", help="benchmarks/README.md section the "
-                    "--results table goes to (default cook_3d, or "
-                    "cook_3d_large with fewer --methods)")
+                    "--results table goes to (default cook_3d)")
     args = ap.parse_args()
     OUT = output_dir(args.out)
-    main(args.sizes, args.hex, args.results, args.methods, args.section)
+    main(args.sizes, args.hex, args.results, args.methods, args.section,
+         args.reference)

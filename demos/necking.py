@@ -38,8 +38,15 @@ displacement) and a VTU series per formulation
 (out/necking/<name>/step_NNN.vtu with a ParaView .pvd collection; u and
 e_p).  ``--results benchmarks/README.md`` writes the table there.
 
+``--tets`` splits the hexahedra into tetrahedra on the same nodes and runs
+each formulation with the thesis' recipe and the PBG ones on MTE1 (all
+but U2, U2P1, U2P1C, U1SIG) with kNN too (their default on tetrahedra,
+``skfem_pg.discretization.recipes``), FEM O1 and O2 in place of H1P0; the
+overkill stays H1P0 on hexahedra.
+
     python demos/necking.py [--n 1] [--overkill 3] [--methods ...] [--full]
                             [--scale 0.1] [--elongation 5] [--full-bar]
+                            [--tets]
 """
 import os
 import time
@@ -48,6 +55,7 @@ import numpy as np
 
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
+from skfem_pg.naming import knn_name
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
@@ -75,12 +83,15 @@ METHODS = {
 }
 
 
-def scene(n, elongation=ELONGATION, full=False, scale=SCALE):
+def scene(n, elongation=ELONGATION, full=False, scale=SCALE, tets=False):
     """One eighth (symmetry planes) or, ``full``, the whole bar clamped at
     both ends, its length and radius ``scale`` times Simo's; ``sc.end``:
-    the moving end, ``sc.quarters``: the force's multiplier."""
+    the moving end, ``sc.quarters``: the force's multiplier.  ``tets``:
+    the hexahedra split into tetrahedra on the same nodes."""
     mesh = pg.meshing.necking_bar(n, length=scale * BAR["length"],
                                   radius=scale * BAR["radius"], full=full)
+    if tets:
+        mesh = pg.meshing.tetrahedra(mesh)
     if full:
         sc = Scene("necking", mesh, STEEL, clamped=["left"], prescribed={
             "right": {0: elongation, 1: 0.0, 2: 0.0}})
@@ -98,10 +109,30 @@ def solved_name(label, full):
     """The name solved and on what: the thesis' own on the whole bar (VC
     boundary variant sn), its minimum-norm variant on the eighth — except
     PPG UnlP0, which is unstable in 3-D with 'm' (``MasterDilatation``
-    refuses it) and so always solves the whole bar with 'sn'."""
-    if full or METHODS.get(label, (label,))[0] is None:
+    refuses it) and so always solves the whole bar with 'sn'.  A label
+    ending in `` kNN`` (``--tets``) solves its name with the kNN recipe."""
+    base, knn = (label[:-4], " kNN") if label.endswith(" kNN") \
+        else (label, "")
+    if full or METHODS.get(base, (base,))[0] is None:
         return label, True
-    return METHODS.get(label, (label,))[0], False
+    return METHODS.get(base, (base,))[0] + knn, False
+
+
+def tet_labels(labels):
+    """On tetrahedra: each PG label with the thesis recipe, and those the
+    kNN recipe applies to (PBG on MTE1: not U2, U2P1, U2P1C, U1SIG) with
+    kNN too (the default there); FEM H1P0 (hexahedra only) becomes O1 and
+    O2."""
+    out = []
+    for label in labels:
+        if label == "FEM H1P0":
+            out += ["FEM O1", "FEM O2"]
+        else:
+            out.append(label)
+            solved = METHODS[label][0]
+            if solved and knn_name(solved):
+                out.append(label + " kNN")
+    return out
 
 
 def run(sc, solved, series=None, verbose=False):
@@ -187,22 +218,25 @@ def row(label, r, ref):
 
 
 def main(n=1, overkill=3, methods=None, results=None, out=None,
-         verbose=False, elongation=ELONGATION, full=False, scale=SCALE):
+         verbose=False, elongation=ELONGATION, full=False, scale=SCALE,
+         tets=False):
     out = output_dir(out)
     print(pg.threads.describe())
-    sc = scene(n, elongation, full, scale)
+    sc = scene(n, elongation, full, scale, tets)
     whole = sc if full else None  # built when a method needs it
     what = "the whole bar" if full else "one eighth"
+    cells = "tetrahedra" if tets else "hexahedra"
     print("necking bar {:g} x Simo's (L = {:g} mm, R = {:g} mm), {}: {} "
-          "hexahedra, {} nodes (n = {}), elongation {:g} mm; H1P0 overkill "
+          "{}, {} nodes (n = {}), elongation {:g} mm; H1P0 overkill "
           "n = {}".format(scale, scale * BAR["length"], scale * BAR["radius"],
-                          what, sc.mesh.nelements, sc.mesh.nvertices, n,
-                          elongation, overkill))
+                          what, sc.mesh.nelements, cells, sc.mesh.nvertices,
+                          n, elongation, overkill))
     rows = {}
-    for label in methods or METHODS:
+    labels = list(methods or METHODS)
+    for label in tet_labels(labels) if tets else labels:
         solved, on_whole = solved_name(label, full)
         if on_whole and whole is None:
-            whole = scene(n, elongation, True, scale)
+            whole = scene(n, elongation, True, scale, tets)
         print("  {} ({}{}) ...".format(label, solved, ", the whole bar: {}"
                                        " nodes".format(whole.mesh.nvertices)
                                        if on_whole and not full else ""),
@@ -230,18 +264,20 @@ def main(n=1, overkill=3, methods=None, results=None, out=None,
     print(text)
     if results:
         print("updated", update_results(
-            results, "necking_{}{}_{:g}mm_{:g}".format(
-                n, "_full" if full else "", elongation, scale),
+            results, "necking_{}{}{}_{:g}mm_{:g}".format(
+                n, "_full" if full else "", "_tets" if tets else "",
+                elongation, scale),
             "`python demos/necking.py --n {} --overkill {} --elongation {:g}"
-            " --scale {:g}{}`: {} of the necking bar ({:g} x Simo's: L = "
-            "{:g} mm, R = {:g} mm), {} hexahedra / {} nodes (overkill "
-            "H1P0: n = {}; VCPPG UnlP0 on the whole bar); max e_p at {:g} mm"
-            " (in parentheses: where a run stopped), forces of the whole "
-            "bar.\n\n".format(
+            " --scale {:g}{}{}`: {} of the necking bar ({:g} x Simo's: L = "
+            "{:g} mm, R = {:g} mm), {} {} / {} nodes (overkill "
+            "H1P0 on hexahedra: n = {}; VCPPG UnlP0 on the whole bar); max "
+            "e_p at {:g} mm (in parentheses: where a run stopped), forces "
+            "of the whole bar.\n\n".format(
                 n, overkill, elongation, scale,
-                " --full-bar" if full else "", what, scale,
-                scale * BAR["length"], scale * BAR["radius"],
-                sc.mesh.nelements, sc.mesh.nvertices, overkill, elongation)
+                " --full-bar" if full else "", " --tets" if tets else "",
+                what, scale, scale * BAR["length"], scale * BAR["radius"],
+                sc.mesh.nelements, cells, sc.mesh.nvertices, overkill,
+                elongation)
             + text))
     plot(rows, os.path.join(out, "necking.png"))
     print("wrote", os.path.join(out, "necking.png"), "and the VTU series in",
@@ -288,6 +324,11 @@ if __name__ == "__main__":
                     "Simo's, on which 5 mm ends before necking)")
     ap.add_argument("--verbose", action="store_true",
                     help="print every converged step")
+    ap.add_argument("--tets", action="store_true",
+                    help="the hexahedra split into tetrahedra on the same "
+                    "nodes: each formulation with the thesis recipe, the "
+                    "VCPBG MTE1 ones also with kNN (their default there), "
+                    "FEM O1 and O2 for H1P0")
     a = ap.parse_args()
     main(6 if a.full else a.n, a.overkill, a.methods, a.results, a.out,
-         a.verbose, a.elongation, a.full_bar, a.scale)
+         a.verbose, a.elongation, a.full_bar, a.scale, a.tets)

@@ -32,7 +32,13 @@ out/taylor.png (length and kinetic energy over time) and a VTU series per
 formulation (out/taylor/<name>/step_NNN.vtu, .pvd; u, v and e_p).
 ``--results benchmarks/README.md`` writes the table there.
 
+``--tets`` splits the hexahedra into tetrahedra on the same nodes and runs
+each formulation with the thesis' recipe and the PBG MTE1 ones (not U2,
+U2P1, U2P1C, U1SIG) with kNN too (their default on tetrahedra), FEM O1 in place of H1 /
+H1P0.
+
     python demos/taylor.py [--n 1] [--methods ...] [--newmark] [--t-end 80]
+                           [--tets]
 """
 import os
 import time
@@ -41,6 +47,7 @@ import numpy as np
 
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
+from skfem_pg.naming import knn_name
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries, step_writer
 from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
@@ -75,8 +82,31 @@ LITERATURE = {"length": (21.26, 21.66), "radius": (6.84, 7.24),
 NEWMARK_STEPS = 1000
 
 
-def scene(n):
-    return Scene("taylor", pg.meshing.taylor_rod(n), COPPER)
+def scene(n, tets=False):
+    """The whole rod; ``tets``: its hexahedra split into tetrahedra on the
+    same nodes."""
+    mesh = pg.meshing.taylor_rod(n)
+    return Scene("taylor", pg.meshing.tetrahedra(mesh) if tets else mesh,
+                 COPPER)
+
+
+def tet_methods(labels):
+    """On tetrahedra: ``(label, solved, explicit, thesis)`` of each label
+    with the thesis recipe, and of the PBG MTE1 ones (not U2, U2P1, U2P1C,
+    U1SIG) with kNN too (the default there); FEM H1 and H1P0 become O1
+    (O2's row-sum lumped mass is not positive)."""
+    out = []
+    for label in labels:
+        solved, explicit, thesis = METHODS[label]
+        if label.startswith("FEM"):
+            if ("FEM O1", "FEM O1", True, None) not in out:
+                out.append(("FEM O1", "FEM O1", True, None))
+        else:
+            out.append((label, solved, explicit, thesis))
+            if knn_name(solved):  # PBG on MTE1 only
+                out.append((label + " kNN", knn_name(solved),
+                            explicit, thesis))
+    return out
 
 
 def run(sc, solved, explicit, t_end=T_END, series=None):
@@ -145,7 +175,7 @@ def _band(v, key):
 
 
 def row(label, r):
-    thesis = METHODS[label][2]
+    thesis = r["thesis"]
     th = "{:.2f} / {:.2f} / {:.2f}".format(*thesis) if thesis else "–"
     per = r["nodes"] * r["steps"] / max(r["seconds"] - r["preprocess"],
                                         1e-9)
@@ -157,23 +187,28 @@ def row(label, r):
             "{:.0f}".format(per), r["status"]]
 
 
-def main(n=1, methods=None, results=None, out=None, t_end=T_END):
+def main(n=1, methods=None, results=None, out=None, t_end=T_END,
+         tets=False):
     out = output_dir(out)
     print(pg.threads.describe())
-    sc = scene(n)
+    sc = scene(n, tets)
+    cells = "tetrahedra" if tets else "hexahedra"
     print("Taylor rod L = {} mm, R = {} mm at {} mm/µs, {} µs: {} "
-          "hexahedra, {} nodes (n = {})".format(
+          "{}, {} nodes (n = {})".format(
               ROD["length"], ROD["radius"], SPEED, t_end, sc.mesh.nelements,
-              sc.mesh.nvertices, n), flush=True)
+              cells, sc.mesh.nvertices, n), flush=True)
     rows = {}
-    for label in methods or DEFAULT:
-        solved, explicit, _ = METHODS[label]
+    labels = methods or DEFAULT
+    runs = tet_methods(labels) if tets else [
+        (label,) + METHODS[label] for label in labels]
+    for label, solved, explicit, thesis in runs:
         print("  {} ({}, {}) ...".format(label, solved, "central differences"
                                          if explicit else "Newmark"),
               flush=True)
         folder = os.path.join(out, "taylor", solved.replace(" ", "_")
                               .replace("+", "p"))
         rows[label] = r = run(sc, solved, explicit, t_end, VTUSeries(folder))
+        r["thesis"] = thesis
         print("    {}: length {:.2f} mm, radius {:.2f} mm, max e_p {:.2f}; "
               "{} steps, {:.0f} s; time split {}".format(
                   r["status"], r["length"], r["radius"], r["ep"],
@@ -193,11 +228,13 @@ def main(n=1, methods=None, results=None, out=None, t_end=T_END):
     print(text)
     if results:
         print("updated", update_results(
-            results, "taylor_{}_{:g}".format(n, t_end),
-            "`python demos/taylor.py --n {} --methods {}`: the whole rod, "
-            "{} hexahedra / {} nodes, {:g} µs.\n\n".format(
-                n, " ".join('"{}"'.format(m) for m in rows),
-                sc.mesh.nelements, sc.mesh.nvertices, t_end) + text))
+            results, "taylor_{}{}_{:g}".format(n, "_tets" if tets else "",
+                                              t_end),
+            "`python demos/taylor.py --n {} --methods {}{}`: the whole rod, "
+            "{} {} / {} nodes, {:g} µs.\n\n".format(
+                n, " ".join('"{}"'.format(m) for m in labels),
+                " --tets" if tets else "", sc.mesh.nelements, cells,
+                sc.mesh.nvertices, t_end) + text))
     plot(rows, os.path.join(out, "taylor.png"))
     print("wrote", os.path.join(out, "taylor.png"), "and the VTU series in",
           os.path.join(out, "taylor"))
@@ -234,6 +271,11 @@ if __name__ == "__main__":
                     "steps (hours)")
     ap.add_argument("--t-end", type=float, default=T_END,
                     help="simulated time [µs] (default 80)")
+    ap.add_argument("--tets", action="store_true",
+                    help="the hexahedra split into tetrahedra on the same "
+                    "nodes: each formulation with the thesis recipe, the "
+                    "MTE1 ones also with kNN (their default there), FEM O1 "
+                    "for H1/H1P0")
     a = ap.parse_args()
     methods = a.methods or (
         [k for k, v in METHODS.items() if v[1]] if a.explicit else
@@ -241,4 +283,4 @@ if __name__ == "__main__":
     if a.newmark:
         methods += [k for k, v in METHODS.items() if not v[1]
                     and k not in methods]
-    main(a.n, methods, a.results, a.out, a.t_end)
+    main(a.n, methods, a.results, a.out, a.t_end, a.tets)

@@ -182,6 +182,17 @@ def parse(name):
     return kw, notes
 
 
+def knn_name(name):
+    """``name`` with the package token ``kNN`` appended if the recipe
+    applies to it (PBG on MTE1: Unl, UnlP0, Unl+P1C, U1SUnl ...), else
+    None (PPG, WTE1's U1SIG, WTE2's U2 ...)."""
+    try:
+        parse(name + " kNN")
+    except ValueError:
+        return None
+    return name + " kNN"
+
+
 def name_of(basis):
     """The full thesis code of a :class:`~skfem_pg.FamilyBasis`, e.g.
     ``"VCBCPBG V5m Unl TL"``: every option written, so that

@@ -163,3 +163,14 @@ def test_formulation_of():
     assert formulation_of("FEM H1P0") == "H1P0"
     with pytest.raises(ValueError, match="cannot read"):
         formulation_of("UnlP0")
+
+
+def test_knn_name_only_where_the_recipe_applies():
+    """``knn_name``: the name with ``kNN`` for PBG on MTE1, None where the
+    recipe is refused (PPG, WTE1's U1SIG, WTE2's U2 family)."""
+    from skfem_pg.naming import knn_name
+    assert knn_name("VCPBG V5m Unl+P1C") == "VCPBG V5m Unl+P1C kNN"
+    assert knn_name("VCBCPBG V5m U1SUnl") == "VCBCPBG V5m U1SUnl kNN"
+    for name in ("VCPBG V3m U1SIG", "VCPBG V3m U2P1", "VCPPG UnlP0",
+                 "VCPBG V3m U2"):
+        assert knn_name(name) is None

@@ -114,6 +114,47 @@ def test_amg_with_rigid_body_modes_matches_direct():
     assert not [w for w in caught if "Indefinite" in str(w.message)]
 
 
+@pytest.mark.parametrize("pardiso", [False, True])
+def test_auto_direct_limit_follows_the_installed_direct_solver(
+        pardiso, monkeypatch):
+    """``auto_direct_limit(dim)``: with PARDISO its unknowns and non-zeros
+    tables, else SuperLU's unknowns (its 3-D crossover is far lower) and
+    no limit on non-zeros."""
+    from skfem_pg.solvers import linear
+    monkeypatch.setattr(linear, "pardiso_available", lambda: pardiso)
+    for d in (2, 3):
+        if pardiso:
+            assert linear.auto_direct_limit(d) == (
+                linear.DIRECT_LIMIT_PARDISO[d],
+                linear.DIRECT_NNZ_LIMIT_PARDISO.get(d))
+        else:
+            assert linear.auto_direct_limit(d) == (linear.DIRECT_LIMIT[d],
+                                                   None)
+    assert linear.DIRECT_LIMIT[3] < linear.DIRECT_LIMIT_PARDISO[3]
+
+
+def test_auto_solver_is_direct_up_to_the_limit_then_amg():
+    """``linear_solver("auto")`` solves directly up to ``direct_limit``
+    unknowns and ``direct_nnz_limit`` non-zeros and by AMG above either,
+    with the same answer."""
+    mesh = fem.MeshTet.init_tensor(*[np.linspace(0, 1, 6)] * 3)
+    b = fem.Basis(mesh, fem.ElementVector(fem.ElementTetP1()))
+    K = pg.assemble(linear_elasticity(LAM, MU), b)
+    D = b.get_dofs(lambda x: np.isclose(x[0], 0)).all()
+    I = np.setdiff1d(np.arange(b.N), D)
+    A, rhs = K[I][:, I].tocsr(), np.ones(len(I))
+    x = []
+    for limits, amg in (((len(I), None), False), ((len(I) - 1, None), True),
+                        ((len(I), A.nnz), False), ((len(I), A.nnz - 1), True)):
+        solve = linear_solver("auto", b.doflocs[:, I], tol=1e-12,
+                              direct_limit=limits[0],
+                              direct_nnz_limit=limits[1])
+        x.append(solve(A, rhs))
+        assert solve.amg.stats["solves"] == amg
+    for xi in x[1:]:
+        assert np.abs(xi - x[0]).max() <= 1e-8 * np.abs(x[0]).max()
+
+
 def test_fd_tangent_matches_consistent_tangent(beam):
     from skfem_pg.formulations import material_tangent
     from skfem_pg.formulations.tangents import fd_tangent

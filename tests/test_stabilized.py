@@ -252,6 +252,25 @@ def test_necking_bar_mesh():
     assert set(whole.boundaries) == {"left", "right"}
 
 
+def test_tetrahedra_split_keeps_nodes_and_boundaries():
+    """``meshing.tetrahedra``: the same nodes, the same volume, and every
+    named boundary covered by twice as many triangles on the same
+    vertices; anything but hexahedra is refused."""
+    hexes = pg.meshing.necking_bar(1)
+    tets = pg.meshing.tetrahedra(hexes)
+    assert isinstance(tets, fem.MeshTet) and np.array_equal(tets.p, hexes.p)
+    vol = [fem.Basis(m, e).dx.sum() for m, e in (
+        (hexes, fem.ElementHex1()), (tets, fem.ElementTetP1()))]
+    assert np.isclose(vol[0], vol[1], rtol=1e-12)
+    assert set(tets.boundaries) == set(hexes.boundaries)
+    for name, facets in hexes.boundaries.items():
+        assert len(tets.boundaries[name]) == 2 * len(facets)
+        assert np.array_equal(np.unique(tets.facets[:, tets.boundaries[name]]),
+                              np.unique(hexes.facets[:, facets]))
+    with pytest.raises(TypeError, match="MeshHex"):
+        pg.meshing.tetrahedra(tets)
+
+
 def test_ppg_unlp0_refused_where_unstable():
     """PPG UnlP0 in 3-D with the min-norm (or p) VC: its tangent at rest
     has eigenvalues with negative real part (here measured again), so

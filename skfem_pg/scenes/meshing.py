@@ -4,6 +4,7 @@ gmsh geometries.
 gmsh is used through its Python API; ``.geo`` sources ship as package data
 in ``skfem_pg/scenes/meshes/`` (:func:`geo_path`).
 """
+import dataclasses
 import os
 import tempfile
 
@@ -246,6 +247,28 @@ def taylor_rod(n=1, length=TAYLOR_ROD["length"],
     return mesh.with_boundaries({
         "impact": lambda x: np.isclose(x[0], 0.0),
         "top": lambda x: np.isclose(x[0], length), **names})
+
+
+def tetrahedra(mesh):
+    """The hexahedral ``mesh`` split into tetrahedra on the same nodes
+    (scikit-fem's ``to_meshtet``), its named boundaries carried over: a
+    boundary keeps the tetrahedral boundary facets whose vertices all lie
+    on its own facets (planar boundaries, as those of
+    :func:`necking_bar`, :func:`taylor_rod`, :func:`cook_membrane_3d`)."""
+    if not isinstance(mesh, fem.MeshHex):
+        raise TypeError("tetrahedra() splits a MeshHex, got {}".format(
+            type(mesh).__name__))
+    tets = mesh.to_meshtet()
+    if not np.array_equal(tets.p, mesh.p):
+        raise RuntimeError("to_meshtet moved or added nodes: the split "
+                           "cannot carry the boundaries over")
+    named = {}
+    for name, facets in (mesh.boundaries or {}).items():
+        on = np.zeros(mesh.nvertices, dtype=bool)
+        on[mesh.facets[:, facets].ravel()] = True
+        bf = tets.boundary_facets()
+        named[name] = bf[on[tets.facets[:, bf]].all(axis=0)]
+    return dataclasses.replace(tets, _boundaries=named or None)
 
 
 def plate_with_hole(a=1.0, L=5.0, n=8, m=None, ratio=6.0):

@@ -79,16 +79,30 @@ def wall_time(row):
     return row["preprocess"] + row["assemble"] + row["solve"]
 
 
+def first_within(rows, method, target):
+    """The first row (node set) of ``method`` from which on its ``err``
+    stays at most ``target`` in every later row (an error that crosses
+    zero on its way is not yet converged), or None."""
+    sel = [r for r in rows if r["method"] == method]
+    hit = None
+    for r in reversed(sel):
+        if r["err"] > target:
+            break
+        hit = r
+    return hit
+
+
 def print_time_to_target(rows, methods, target=0.01, what="error"):
-    """Print, per method, the wall time of the first row (node set) whose
-    ``err`` is at most ``target``."""
-    print("\nwall time to reach {:g} % {} (first node set that does):"
+    """Print, per method, the wall time of the first row (node set) from
+    which on its ``err`` stays at most ``target`` (:func:`first_within`)."""
+    print("\nwall time to reach {:g} % {} (first node set from which on "
+          "it stays there):"
           .format(100 * target, what))
     for name in methods:
-        hit = [r for r in rows if r["method"] == name and r["err"] <= target]
+        hit = first_within(rows, name, target)
         if hit:
             print("  {:24s} {:7.3f} s ({} nodes)".format(
-                name, wall_time(hit[0]), hit[0]["nodes"]))
+                name, wall_time(hit), hit["nodes"]))
         else:
             print("  {:24s} not reached".format(name))
 

@@ -4,7 +4,9 @@ the history of plastic models per converged step), checkpoints; dynamics:
 lumped mass, implicit Newmark, explicit central differences, a rigid
 frictionless wall, energy bookkeeping."""
 from .linear import (direct, linear_solver, AMGSolver, rigid_body_modes,
-                     pardiso_available, DIRECT_LIMIT)
+                     pardiso_available, DIRECT_LIMIT,
+                     DIRECT_LIMIT_PARDISO, DIRECT_NNZ_LIMIT_PARDISO,
+                     auto_direct_limit)
 from .static import newton, ConvergenceError, PG_CANDIDATES
 from .mass import lumped_mass
 from .dynamics import DynamicsError, Trajectory, EnergyBalance
@@ -16,7 +18,9 @@ from . import checkpoint
 from ..dofs import as_dofs
 
 __all__ = ["direct", "linear_solver", "AMGSolver", "rigid_body_modes",
-           "pardiso_available", "DIRECT_LIMIT", "newton",
+           "pardiso_available", "DIRECT_LIMIT", "DIRECT_LIMIT_PARDISO",
+           "DIRECT_NNZ_LIMIT_PARDISO",
+           "auto_direct_limit", "newton",
            "ConvergenceError", "PG_CANDIDATES", "as_dofs", "checkpoint",
            "lumped_mass", "DynamicsError", "Trajectory", "EnergyBalance",
            "RigidWall", "newmark", "central_difference", "stable_time_step",

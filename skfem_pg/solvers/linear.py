@@ -105,27 +105,35 @@ def direct(A, b, ordering="auto", **kwargs):
     return x
 
 
+#: one ``pypardiso.PyPardisoSolver`` per matrix type, kept: creating one
+#: looks up MKL's library (about 0.12 s), more than factorizing 3k
+#: unknowns; its factors are freed after every solve
+_PARDISO_SOLVERS = {}
+
+
 def _pardiso(A, b):
     """MKL PARDISO: a symmetric matrix as real symmetric indefinite
     (``mtype=-2``, LDL^T with Bunch–Kaufman pivoting, the upper triangle
     only: half the fill of the LU mode, and PG's indefinite late Newton
     tangents solve too), otherwise LU (``mtype=11``)."""
     import pypardiso
-    if _symmetric(A):
+    mtype = -2 if _symmetric(A) else 11
+    if mtype == -2:
         # the upper triangle with every diagonal entry stored (PARDISO's
         # symmetric modes need them; a saddle point's are zero)
         U = sp.triu(A, format="coo")
         n = A.shape[0]
-        U = sp.csr_matrix((np.r_[U.data, np.zeros(n)],
+        A = sp.csr_matrix((np.r_[U.data, np.zeros(n)],
                            (np.r_[U.row, np.arange(n)],
                             np.r_[U.col, np.arange(n)])), shape=A.shape)
-        solver = pypardiso.PyPardisoSolver(mtype=-2)
-        x = solver.solve(U, b)
-    else:
-        solver = pypardiso.PyPardisoSolver(mtype=11)
-        x = solver.solve(A, b)
-    solver.free_memory(everything=True)
-    return x
+    solver = _PARDISO_SOLVERS.get(mtype)
+    if solver is None:
+        solver = _PARDISO_SOLVERS[mtype] = pypardiso.PyPardisoSolver(
+            mtype=mtype)
+    try:
+        return solver.solve(A, b)
+    finally:
+        solver.free_memory(everything=True)
 
 
 #: largest relative residual ``|A x - b| / (|A| |x|)`` accepted from a
@@ -142,10 +150,39 @@ def _symmetric(A, tol=1e-12):
     return d.nnz == 0 or np.abs(d.data).max() <= tol * np.abs(A.data).max()
 
 
-#: ``"auto"``: largest direct solve per spatial dimension (unknowns).
-#: Measured crossovers against AMG-CG: 2-D above 60k; 3-D O1 at ~4k, PG
-#: at ~10k (3-D Cook tetrahedra).
-DIRECT_LIMIT = {2: 60_000, 3: 10_000}
+#: ``"auto"``: the largest direct solve (unknowns) per spatial dimension
+#: with the default install's SuperLU.  3-D Cook tetrahedra, one solve of
+#: the linear system (``benchmarks/solvers_3d.py``): SuperLU (COLAMD)
+#: against AMG-CG, PG (kNN) 0.17 / 0.32 s at 3.7k unknowns and 2.4 / 1.1 s
+#: at 11k, O1 0.05 / 0.18 s and 0.57 / 0.30 s: the crossover is near 6k
+#: for both.  2-D: above 60k.
+DIRECT_LIMIT = {2: 60_000, 3: 6_000}
+#: the same with MKL PARDISO (``[pardiso]`` extra; its symmetric LDL^T),
+#: which also stops at :data:`DIRECT_NNZ_LIMIT_PARDISO` non-zeros.
+DIRECT_LIMIT_PARDISO = {2: 60_000, 3: 150_000}
+#: ``"auto"`` with PARDISO: the largest direct solve in non-zeros per
+#: spatial dimension.  Its cost follows the matrix graph, not the unknowns
+#: alone: 3-D Cook tetrahedra, one solve against AMG-CG
+#: (``benchmarks/solvers_3d.py``), PG (150 non-zeros per row) 2.6 / 2.1 s
+#: at 25k unknowns (3.6M non-zeros), 4.3 / 5.0 s at 40k (5.9M), 10.2 /
+#: 9.3 s at 74k (11M); O1 (42 per row) 2.1 / 2.9 s at 74k (3.1M), 5.6 /
+#: 6.2 s at 133k (5.7M).  In Newton (``benchmarks/newton_3d.py``) a kept
+#: AMG hierarchy costs PG on tetrahedra 14.5 s per iteration at 74k (11M),
+#: about a factorization's; PG with the thesis recipe on a 40^3/4 hex grid
+#: (55k unknowns, 15M non-zeros) 72 s with AMG (242 CG iterations) against
+#: 14.8 s direct.  Hence 16M.
+DIRECT_NNZ_LIMIT_PARDISO = {3: 16_000_000}
+
+
+def auto_direct_limit(dim):
+    """``(unknowns, non-zeros)``: the ``"auto"`` solver's largest direct
+    solve in ``dim`` dimensions — :data:`DIRECT_LIMIT_PARDISO` and
+    :data:`DIRECT_NNZ_LIMIT_PARDISO` if PARDISO is installed, else
+    :data:`DIRECT_LIMIT` (no limit on non-zeros)."""
+    if pardiso_available():
+        return (DIRECT_LIMIT_PARDISO.get(dim, 60_000),
+                DIRECT_NNZ_LIMIT_PARDISO.get(dim))
+    return DIRECT_LIMIT.get(dim, 60_000), None
 
 
 def _node_blocks(doflocs):
@@ -327,7 +364,8 @@ class AMGSolver:
 
 
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
-                  symmetric=True, candidates=0, components=None):
+                  symmetric=True, candidates=0, components=None,
+                  direct_nnz_limit=None):
     """A solver ``(A, b) -> x`` for ``fem.solve`` and Newton's method.
 
     ``"direct"``: :func:`direct` (PARDISO if installed, else SuperLU with
@@ -336,8 +374,9 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     system for the rigid-body modes; keeps its hierarchy across calls;
     ``candidates`` extra near-null-space vectors, :data:`PG_CANDIDATES`
     for family bases in Newton's method);
-    ``"auto"``: direct up to ``direct_limit`` unknowns (default
-    :data:`DIRECT_LIMIT` of the dimension of ``doflocs``), else AMG.
+    ``"auto"``: direct up to ``direct_limit`` unknowns and
+    ``direct_nnz_limit`` non-zeros (defaults: :func:`auto_direct_limit`
+    of the dimension of ``doflocs``), else AMG.
     ``components``: each condensed dof's component (for the rigid-body
     modes when the free dofs are not whole nodes, e.g. with symmetry
     planes); Newton's method passes them.
@@ -345,8 +384,10 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     dim = 2 if doflocs is None else doflocs.shape[0]
     ordering = ("pardiso" if pardiso_available()
                 else "colamd" if dim == 3 else "rcm+mmd")
-    if direct_limit is None:
-        direct_limit = DIRECT_LIMIT.get(dim, 60_000)
+    if direct_limit is None and direct_nnz_limit is None:
+        direct_limit, direct_nnz_limit = auto_direct_limit(dim)
+    elif direct_limit is None:
+        direct_limit = auto_direct_limit(dim)[0]
     if kind not in ("auto", "direct", "amg"):
         raise ValueError("unknown linear solver {!r}: use 'auto', 'direct' "
                          "or 'amg'".format(kind))
@@ -357,8 +398,9 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     def solve(A, b, **kwargs):
         k = kind
         if k == "auto":
-            k = "direct" if A.shape[0] <= direct_limit or doflocs is None \
-                else "amg"
+            small = A.shape[0] <= direct_limit and (
+                direct_nnz_limit is None or A.nnz <= direct_nnz_limit)
+            k = "direct" if small or doflocs is None else "amg"
         if k == "direct":
             return direct(A, b, ordering)
         return amg(A, b)
