@@ -20,6 +20,12 @@ class CorrectionError(FamilyError):
     derivatives)."""
 
 
+class SingularSystemError(ValueError):
+    """A linear system has no unique solution (rigid-body modes left free
+    by too few Dirichlet conditions, a mechanism) or its solve did not
+    reach a residual that makes the answer trustworthy."""
+
+
 class UnsupportedMeshError(TypeError):
     """The mesh type is not a linear scikit-fem mesh (tri, quad, tet, hex)."""
 

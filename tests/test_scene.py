@@ -112,13 +112,16 @@ def test_sliding_boundaries_pass_the_patch_test_or_are_refused(dim):
     mesh = cls.init_tensor(*[np.linspace(0, 1, k + 1) for k in shape])
     mesh = mesh.with_boundaries({
         "x0": lambda x: np.isclose(x[0], 0.0),
+        "y0": lambda x: np.isclose(x[1], 0.0),
         "bottom": lambda x: np.isclose(x[-1], 0.0),
         "top": lambda x: np.isclose(x[-1], 1.0)})
     t = np.zeros(dim)
     t[-1] = -0.01
+    rollers = {"x0": {0: 0.0}, "bottom": {dim - 1: 0.0}}
+    if dim == 3:  # a second symmetry plane holds the y translation
+        rollers["y0"] = {1: 0.0}
     scene = Scene("rollers", mesh, mat.LinearElastic(1.0, 1.0),
-                  prescribed={"x0": {0: 0.0}, "bottom": {dim - 1: 0.0}},
-                  tractions={"top": t})
+                  prescribed=rollers, tractions={"top": t})
     for name in ("VCBCPBG V5m Unl", "VCBCPBG V5p Unl"):
         u = scene.solve(name).u.reshape(-1, dim).T
         for c in (0, dim - 1):  # u_c / x_c is one constant

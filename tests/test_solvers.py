@@ -1,6 +1,7 @@
 """Newton with adaptive load steps on PG and FE bases."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 import skfem as fem
 
 import skfem_pg as pg
@@ -153,6 +154,23 @@ def test_auto_solver_is_direct_up_to_the_limit_then_amg():
         assert solve.amg.stats["solves"] == amg
     for xi in x[1:]:
         assert np.abs(xi - x[0]).max() <= 1e-8 * np.abs(x[0]).max()
+
+
+@pytest.mark.parametrize("n", [1, 7, 60])
+def test_submatrix_equals_scipy_row_then_column_selection(n):
+    """``submatrix(A, I)`` (one copy) equals ``A[I][:, I]`` for index
+    arrays and masks, empty rows and an empty selection included."""
+    rng = np.random.default_rng(n)
+    A = sp.random(n, n, density=0.2, random_state=n, format="csr")
+    A = A.tolil()
+    A[n // 2, :] = 0  # an empty row
+    A = A.tocsr()
+    for I in (np.arange(n), np.sort(rng.choice(n, n // 2, replace=False)),
+              rng.random(n) < 0.4, np.zeros(n, dtype=bool)):
+        S, R = pg.solvers.submatrix(A, I), A[I][:, I].tocsr()
+        S.check_format(full_check=True)
+        assert S.shape == R.shape
+        assert abs(S - R).sum() == 0
 
 
 def test_fd_tangent_matches_consistent_tangent(beam):

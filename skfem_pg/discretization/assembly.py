@@ -292,28 +292,8 @@ def block_pattern(basis, view=None):
                                    return_inverse=True)
                 pieces.append((bi, sl, u, inv.astype(
                     np.int32 if len(u) < 2 ** 31 else np.int64)))
-        basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces, {})
+        basis._pattern = (S.indptr.copy(), S.indices.copy(), pieces)
     return basis._pattern
-
-
-def _scatter_index(u, inv, m, nc, transposed):
-    """Entry-level scatter of one chunk: for local matrices laid out
-    ``(k, l, i, c_l, c_i)`` (or ``(k, c_i, i, c_l, l)`` if
-    ``transposed``), the index of every entry into the chunk's
-    ``nc²·len(u)`` data entries, and those entries' positions in the
-    ``(nnz_blocks, nc, nc)`` data array."""
-    n2 = nc * nc
-    dtype = np.int32 if len(u) * n2 < 2 ** 31 else np.int64
-    b = inv.reshape(-1, m, m).astype(dtype) * n2  # (k, l, i)
-    cc = np.arange(nc, dtype=dtype)
-    if transposed:  # [k, a, i, c, l] -> inv[k, l, i] n2 + c nc + a
-        idx = (b.transpose(0, 2, 1)[:, None, :, None, :]
-               + cc[None, :, None, None, None]
-               + nc * cc[None, None, None, :, None])
-    else:  # [k, l, i, c, a]
-        idx = (b[..., None, None] + nc * cc[:, None] + cc[None, :])
-    full = (u[:, None] * n2 + np.arange(n2)).ravel()
-    return idx.ravel(), full
 
 
 def _assemble_bilinear(form, basis, view, vview, kwargs, local_extra=None):
@@ -383,25 +363,28 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     component-major transpose ``(ne, c, m, c, m)`` indexed
     ``[k, c_i, i, c_l, l]`` instead (what a batched product yields
     without a strided copy).  Entries are summed into the cached
-    :func:`block_pattern` through one precomputed scatter index per chunk
-    (one ``bincount`` each).
+    :func:`block_pattern` by the chunk's node-pair indices, one
+    ``bincount`` per component pair (an entry-level index would hold
+    ``c²`` times the integers).
     """
     view = _view(basis) if view is None else view
     nc = view.nc
-    indptr, indices, pieces, scatter = block_pattern(basis, view)
-    if transposed not in scatter:
-        scatter[transposed] = [
-            _scatter_index(u, inv, view.blocks[bi].nloc, nc, transposed)
-            for bi, sl, u, inv in pieces]
-    data = np.zeros(len(indices) * nc * nc)
-    for (bi, sl, u, inv), (idx, full) in zip(pieces, scatter[transposed]):
+    indptr, indices, pieces = block_pattern(basis, view)
+    data = np.zeros((len(indices), nc, nc))
+    for bi, sl, u, inv in pieces:
         K = local_matrices(bi, view.blocks[bi], sl)
-        data[full] += np.bincount(idx, weights=K.ravel(),
-                                  minlength=len(full))
+        if transposed:  # [k, c_i, i, c_l, l] -> [k, l, i, c_l, c_i]
+            K = K.transpose(0, 4, 2, 3, 1)
+        # one bincount per component pair over the chunk's block
+        # indices: no entry-level index is kept (nc² times the memory)
+        for a in range(nc):
+            for c in range(nc):
+                data[u, a, c] += np.bincount(
+                    inv, weights=K[..., a, c].ravel(), minlength=len(u))
     N = basis.N
     if nc == 1:
-        return sp.csr_matrix((data, indices, indptr), shape=(N, N))
-    return sp.bsr_matrix((data.reshape(-1, nc, nc), indices, indptr),
+        return sp.csr_matrix((data.ravel(), indices, indptr), shape=(N, N))
+    return sp.bsr_matrix((data, indices, indptr),
                          shape=(N, N)).tocsr()
 
 

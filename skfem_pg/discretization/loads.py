@@ -18,8 +18,34 @@ correction at a particle shared in proportion to the part of its area vector
 lying on the loaded ``facets`` (exact on a flat face and wherever all faces of
 the particle carry the same stress).
 """
+import warnings
+
 import numpy as np
 import skfem as fem
+
+
+def call_user(f, x, what, *args):
+    """``f(x, *args)`` of a user's callable as a float array.  ``x`` goes
+    in as a plain, writable copy: scikit-fem hands forms its points as a
+    ``DiscreteField``, on which ``np.zeros_like(x)`` is a ``DiscreteField``
+    too and item assignment (``o[1] = 0.01``) is lost — a load that is
+    silently zero.  Non-finite values raise, naming ``what``."""
+    x = np.array(np.asarray(x), dtype=float)
+    v = np.array(np.asarray(f(x, *args)), dtype=float)
+    bad = ~np.isfinite(v)
+    if bad.any():
+        raise ValueError("{} returned {} non-finite values".format(
+            what, int(bad.sum())))
+    return v
+
+
+def warn_if_zero(values, what):
+    """A user's load function that returned zero at every point is almost
+    never what was meant (e.g. item assignment on a view that was lost):
+    say so."""
+    if values.size and not np.any(values):
+        warnings.warn("{} is zero at every point it was evaluated at: no "
+                      "load is applied".format(what), stacklevel=3)
 
 
 def _facet_basis(basis, facets, what):
@@ -41,12 +67,15 @@ def traction(basis, facets, t):
     """
     fb = _facet_basis(basis, facets, "traction")
     vector = basis.ncomp is not None
-    if not callable(t):
+    if callable(t):
+        tq = call_user(t, fb.global_coordinates(), "the traction t(x)")
+        warn_if_zero(tq, "the traction t(x)")
+    else:
         t = _constant(t, basis, "traction t")
 
     @fem.LinearForm
     def load(v, w):
-        tv = t(w.x) if callable(t) else t
+        tv = call_user(t, w.x, "the traction t(x)") if callable(t) else t
         if vector:
             tv = np.asarray(tv, dtype=float)
             if tv.ndim == 1:
@@ -61,7 +90,7 @@ def traction(basis, facets, t):
         dlen = np.linalg.norm(A + dA, axis=0) - np.linalg.norm(A, axis=0)
         x = basis.particles.x
         if callable(t):
-            tv = np.asarray(t(x[:, :, None]), dtype=float)[..., 0]
+            tv = call_user(t, x[:, :, None], "the traction t(x)")[..., 0]
         else:
             tv = np.broadcast_to(np.reshape(np.asarray(t, dtype=float),
                                             (-1, 1)), (max(1, np.size(t)),
@@ -123,7 +152,11 @@ def body_force(basis, b, rho=1.0):
     x, V = basis.particles.x, basis.particles.volumes
     n = len(V)
     nc = 1 if basis.ncomp is None else basis.ncomp
-    bv = np.asarray(b(x) if callable(b) else b, dtype=float)
+    if callable(b):
+        bv = call_user(b, x, "the body force b(x)")
+        warn_if_zero(bv, "the body force b(x)")
+    else:
+        bv = np.asarray(b, dtype=float)
     if callable(b):
         shapes = [(nc, n)] if nc > 1 else [(n,), (1, n)]
     else:

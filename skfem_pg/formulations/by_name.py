@@ -46,7 +46,22 @@ def _incompressible(material):
 
 def model_for(formulation, basis, material, tangent="consistent"):
     """The model of ``formulation`` (a token of Table 7.1 or an FE
-    method) on ``basis`` with ``material``."""
+    method) on ``basis`` with ``material``.  An unknown token, or a
+    family basis whose shape functions are not the token's
+    (:data:`~skfem_pg.naming.SHAPES`: ``U2``, ``U2P1``, ``U2P1C`` need
+    WTE2), raises ``ValueError`` naming it."""
+    from ..naming import FE_NAMES, SHAPES
+    if formulation not in SHAPES and formulation not in FE_NAMES:
+        raise ValueError(
+            "unknown formulation {!r}: Table 7.1 tokens are {}; FE methods "
+            "{}".format(formulation, ", ".join(SHAPES), ", ".join(FE_NAMES)))
+    shape = getattr(basis, "shape", None)
+    if isinstance(shape, str) and formulation in SHAPES \
+            and SHAPES[formulation] == "WTE2" and shape != "WTE2":
+        raise ValueError(
+            "{} is a formulation of WTE2 shape functions (Table 7.1); this "
+            "basis has {}: build it with shape='WTE2' (or use the thesis "
+            "name, e.g. 'PBG {}')".format(formulation, shape, formulation))
     if formulation in STABILIZED:
         return STABILIZED[formulation].of(basis, material)
     if formulation in ("Q1P0", "H1P0"):

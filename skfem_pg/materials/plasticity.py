@@ -86,7 +86,8 @@ class J2Plasticity(Material):
     Parameters (the thesis' symbols, (2.46)–(2.49))
     ----------
     mu, K
-        Shear and bulk modulus of the elastic part.
+        Shear and bulk modulus of the elastic part (``K = np.inf``:
+        incompressible, for the formulations that carry the pressure).
     sigma_y0
         Initial yield stress.
     H
@@ -105,10 +106,22 @@ class J2Plasticity(Material):
     stateful = True
 
     def __init__(self, mu, K, sigma_y0, H=0.0, sigma_yinf=None, delta=0.0):
-        if np.isfinite(K):
-            self.mu, self.K = check_moduli(mu=mu, K=K)
-        else:
+        if isinstance(K, (int, float, np.number)) and np.isposinf(K):
+            # incompressible: the documented use of inf
             self.mu, self.K = check_moduli(mu=mu)[0], np.inf
+        else:  # nan, -inf and K <= 0 are refused by name
+            self.mu, self.K = check_moduli(mu=mu, K=K)
+        for name, value in (("sigma_y0", sigma_y0), ("H", H),
+                            ("sigma_yinf", sigma_yinf), ("delta", delta)):
+            if value is None:
+                continue
+            try:
+                ok = np.isfinite(float(value))
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                raise ValueError("J2Plasticity: {} must be a finite number, "
+                                 "got {!r}".format(name, value))
         self.sigma_y0 = float(sigma_y0)
         self.H = float(H)
         self.sigma_yinf = float(sigma_y0 if sigma_yinf is None

@@ -10,7 +10,9 @@ reference.  Files live in ``$SKFEM_PG_CACHE`` (default
 rename), an unreadable entry is recomputed with a warning naming it, and a
 cache that cannot be written warns and still returns the reference.
 """
+import hashlib
 import os
+import re
 import tempfile
 import warnings
 import zipfile
@@ -24,8 +26,10 @@ QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
 
 #: bump when the stored content changes meaning (3: prescribed components
-#: of quadratic elements constrain their facet dofs too)
-CACHE_FORMAT = 3
+#: of quadratic elements constrain their facet dofs too; 4: the key holds
+#: the callable loads' values, the load steps and the solve keywords, the
+#: file its format and a checksum of its content)
+CACHE_FORMAT = 4
 
 
 def cache_dir():
@@ -35,18 +39,54 @@ def cache_dir():
                                        "skfem_pg"))
 
 
-def _load(fn, mesh_type):
+def _checksum(arrays):
+    """SHA-1 of the named arrays (names, shapes, dtypes and bytes)."""
+    h = hashlib.sha1()
+    for k in sorted(arrays):
+        a = np.ascontiguousarray(arrays[k])
+        h.update("{} {} {}".format(k, a.shape, a.dtype).encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _load(fn, mesh_type, method, probes):
+    """The stored :class:`Reference`; ``ValueError`` naming what does not
+    fit: format, checksum (an edited file), the solution's length for
+    ``method`` on the stored mesh, the probe names."""
     with np.load(fn) as data:
-        mesh = mesh_type(data["p"], data["t"])
-        probes = {k[6:]: data[k] for k in data.files
-                  if k.startswith("probe_")}
-        return mesh, data["u"], probes
+        arrays = {k: data[k] for k in data.files}
+    fmt = arrays.pop("format", None)
+    if fmt is None or int(fmt) != CACHE_FORMAT:
+        raise ValueError("format {} where {} is expected".format(
+            None if fmt is None else int(fmt), CACHE_FORMAT))
+    stored = str(arrays.pop("checksum", ""))
+    if stored != _checksum(arrays):
+        raise ValueError("its checksum does not match its content")
+    got = {k[6:]: v for k, v in arrays.items() if k.startswith("probe_")}
+    if sorted(got) != sorted(probes):
+        raise ValueError("probes {} where the scene has {}".format(
+            sorted(got), sorted(probes)))
+    ref = Reference(mesh_type(arrays["p"], arrays["t"]), method,
+                    arrays["u"], got)
+    if arrays["u"].shape != (ref.basis.N,):
+        raise ValueError("u has shape {}, {} on its mesh needs ({},)".format(
+            arrays["u"].shape, method, ref.basis.N))
+    return ref
+
+
+def cache_name(name):
+    """A scene name as a file name part: letters, digits, ``-``, ``_`` and
+    ``.`` kept, anything else (path separators, ``..``) replaced by
+    ``_`` — no name writes outside :func:`cache_dir`."""
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", str(name)).lstrip(".")
+    return safe.replace("..", "_") or "scene"
 
 
 def _store(fn, **arrays):
     """Write ``fn`` atomically; warn (and return False) if it cannot be
     written."""
     d = os.path.dirname(fn)
+    arrays = dict(arrays, checksum=_checksum(arrays), format=CACHE_FORMAT)
     try:
         os.makedirs(d, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp.npz")
@@ -112,17 +152,23 @@ class Reference:
 
 def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
     """Solve ``scene`` on its mesh refined ``refine`` times with the
-    quadratic element of its mesh type (or ``method``); cached."""
+    quadratic element of its mesh type (or ``method``); cached under
+    :meth:`Scene.fingerprint` of the problem, ``refine``, ``method`` and
+    every ``solve_kwargs`` (a tolerance makes another reference).  A
+    cached entry is used only if its format, checksum, solution length
+    and probe names fit; otherwise it is recomputed with a warning."""
     base = {fem.MeshTri1: "T1", fem.MeshQuad1: "Q1", fem.MeshTet1: "O1",
             fem.MeshHex1: "H1"}[type(scene.mesh)]
     method = method or QUADRATIC[base]
-    key = scene.fingerprint(refine, method, CACHE_FORMAT)
-    fn = os.path.join(cache_dir(), "{}-{}.npz".format(scene.name, key[:20]))
+    key = scene.fingerprint(refine, method, CACHE_FORMAT,
+                            sorted((k, repr(v))
+                                   for k, v in solve_kwargs.items()))
+    fn = os.path.join(cache_dir(), "{}-{}.npz".format(cache_name(scene.name),
+                                                      key[:20]))
     mesh = scene.mesh.refined(refine) if refine else scene.mesh
     if os.path.exists(fn):
         try:
-            mesh, u, probes = _load(fn, type(scene.mesh))
-            return Reference(mesh, method, u, probes)
+            return _load(fn, type(scene.mesh), method, scene.probes)
         except (OSError, ValueError, KeyError, EOFError,
                 zipfile.BadZipFile) as err:
             warnings.warn("the cached overkill reference {} is unreadable "

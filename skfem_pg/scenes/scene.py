@@ -41,7 +41,8 @@ import numpy as np
 import skfem as fem
 
 from ..discretization.basis import FamilyBasis
-from ..discretization.loads import traction as pg_traction
+from ..discretization.loads import (call_user, traction as pg_traction,
+                                    warn_if_zero)
 from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
 from ..formulations.updated_lagrange import UpdatedLagrange
@@ -187,7 +188,39 @@ class Scene:
                      exact(self.prescribed),
                      exact({k: v if callable(v) else np.asarray(v, float)
                             for k, v in self.tractions.items()}),
-                     exact(self.probes), exact(self.params)))
+                     exact(self.probes), exact(self.params),
+                     exact(self.steps)))
+
+    def load_samples(self):
+        """The values of every callable load at points where it acts: a
+        traction ``t(x)`` at the vertices and centroid of each facet of its
+        boundary, a prescribed ``f(x, t)`` there at load factors 1/4, 1/2
+        and 1.  They join the :meth:`fingerprint`, so a function whose
+        result changes (it reads a global, a file, ...) changes the key
+        even when its code does not."""
+        mesh = self.mesh
+        out = []
+
+        def points(name):
+            f = np.asarray(mesh.boundaries[name]) if name in (
+                mesh.boundaries or {}) else np.asarray(
+                    mesh.normalize_facets(name))
+            v = mesh.p[:, mesh.facets[:, f]]  # (d, vertices, facets)
+            x = np.concatenate([v, v.mean(axis=1, keepdims=True)], axis=1)
+            return np.ascontiguousarray(x.transpose(0, 2, 1))  # (d, nf, k)
+        for name, t in sorted(self.tractions.items()):
+            if callable(t):
+                out.append((name, call_user(t, points(name),
+                                            "the traction on {!r}"
+                                            .format(name))))
+        for name, how in sorted(self.prescribed.items()):
+            if callable(how):
+                x = points(name).reshape(self.dim, -1)
+                for lf in (0.25, 0.5, 1.0):
+                    out.append((name, lf, call_user(
+                        how, x, "the prescribed f(x, t) on {!r}".format(name),
+                        lf)))
+        return out
 
     def fingerprint(self, *extra):
         """SHA-1 of :meth:`key`, the mesh (vertices, elements and every
@@ -195,6 +228,9 @@ class Scene:
         fingerprint is valid for exactly this problem."""
         h = hashlib.sha1()
         h.update(self.key().encode())
+        for sample in self.load_samples():
+            h.update(repr(sample[:-1]).encode())
+            h.update(np.ascontiguousarray(sample[-1]).tobytes())
         mesh = self.mesh
         h.update(type(mesh).__name__.encode())
         for a in (mesh.p, mesh.t):
@@ -251,7 +287,8 @@ class Scene:
             for f, idx in moving:
                 for c in range(d):
                     x = locs[:, idx[c]]
-                    val = np.asarray(f(x, t), dtype=float)
+                    val = call_user(f, x, "the prescribed displacement "
+                                    "f(x, t)", t)
                     if val.shape != x.shape:
                         raise ValueError(
                             "a prescribed displacement f(x, t) must return "
@@ -270,8 +307,13 @@ class Scene:
                                  "got shape {}".format(name, self.dim,
                                                        t.shape))
 
+        what = "the traction t(x) on {!r}".format(name)
+        if callable(t):
+            warn_if_zero(call_user(t, fb.global_coordinates(), what), what)
+
         def load(v, w):
-            tv = t(w.x) if callable(t) else t[:, None, None]
+            tv = call_user(t, w.x, what) if callable(t) \
+                else t[:, None, None]
             return sum(tv[a] * v[a] for a in range(self.dim))
         return fem.LinearForm(load).assemble(fb)
 
@@ -370,6 +412,11 @@ class Scene:
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         elif method in FE_METHODS:
+            if basis_kwargs:
+                raise ValueError(
+                    "{} is a scikit-fem element: the family basis options "
+                    "{} do not apply to it".format(
+                        method, ", ".join(sorted(basis_kwargs))))
             mesh = self.fe_mesh(method, mesh)
             _, E = FE_METHODS[method]
             basis = fem.Basis(mesh, fem.ElementVector(E()),

@@ -31,6 +31,15 @@ class RigidWall:
     def __init__(self, axis, position=0.0, side=1, tol=None):
         if side not in (1, -1):
             raise ValueError("side must be +1 or -1, got {!r}".format(side))
+        if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)):
+            raise ValueError("axis must be an integer (0: x, 1: y, 2: z), "
+                             "got {!r}".format(axis))
+        if not np.isfinite(position):
+            raise ValueError("the wall's position must be finite, got {!r}"
+                             .format(position))
+        if tol is not None and not (np.isfinite(tol) and tol >= 0):
+            raise ValueError("tol must be a non-negative length, got {!r}"
+                             .format(tol))
         self.axis, self.position, self.side = int(axis), float(position), side
         self.tol = tol
 
@@ -89,9 +98,18 @@ class RigidWall:
 def hold_initial(walls, candidates, u, v, a, m, held):
     """Hold the candidates that start on a wall moving or pushed into it
     (zero normal velocity and acceleration); returns the kinetic energy
-    the walls took."""
+    the walls took.  A body that starts behind a wall (displaced there by
+    ``u0``) is refused by name."""
     lost = 0.0
     for w, c in zip(walls, candidates):
+        behind = w.penetrating(u)
+        if behind.any():
+            i = np.flatnonzero(behind)[0]
+            raise ValueError(
+                "{!r}: the initial displacements put {} node(s) behind the "
+                "wall, first dof {} at {} = {:.6g}".format(
+                    w, int(behind.sum()), c[i], "xyz"[w.axis],
+                    w.X[i] + u[c[i]]))
         on = w.on_wall(u)
         into = w.side * (v[c] + a[c]) < 0
         h = c[on & into]

@@ -47,6 +47,56 @@ def time_functions(model, f_ext, u_D):
     return wrap(f_ext, "f_ext"), wrap(u_D, "u_D")
 
 
+#: most steps one time integration may take: a run whose steps would
+#: exceed it (t_end / dt, or a stable step that collapses) stops with a
+#: named error instead of running for days
+MAX_STEPS = 100_000_000
+
+
+def check_run(n_u, N, m, t_end, dt=None, u0=None, v0=None,
+              dt_required=False):
+    """Named errors for a time integration's inputs: the lumped mass
+    (one finite positive entry per displacement dof), ``t_end`` (finite,
+    positive), ``dt`` (finite, positive; at most :data:`MAX_STEPS` steps
+    to ``t_end``), ``u0`` (``n_u`` or ``N`` entries) and ``v0`` (``n_u``),
+    all finite.  Returns the mass as an array."""
+    m = np.asarray(m, dtype=float)
+    if m.shape != (n_u,):
+        raise ValueError("the mass needs one entry per displacement dof "
+                         "({}), got shape {}".format(n_u, m.shape))
+    bad = np.flatnonzero(~(np.isfinite(m) & (m > 0)))
+    if bad.size:
+        raise ValueError("the mass must be finite and positive at every "
+                         "dof: {} entries are not (first: dof {} = {})"
+                         .format(bad.size, bad[0], m[bad[0]]))
+    if not (np.isfinite(t_end) and t_end > 0):
+        raise ValueError("t_end must be a positive time, got {!r}"
+                         .format(t_end))
+    if dt is None:
+        if dt_required:
+            raise ValueError("dt is required")
+    elif not (np.isfinite(dt) and dt > 0):
+        raise ValueError("dt must be a positive time step, got {!r}"
+                         .format(dt))
+    elif t_end / dt > MAX_STEPS:
+        raise ValueError("t_end / dt = {:.3g} steps: more than MAX_STEPS "
+                         "= {:.3g} (skfem_pg.solvers.dynamics)".format(
+                             t_end / dt, MAX_STEPS))
+    for name, v, sizes in (("u0", u0, (n_u, N)), ("v0", v0, (n_u,))):
+        if v is None:
+            continue
+        v = np.asarray(v, dtype=float)
+        if v.ndim != 1 or v.shape[0] not in sizes:
+            raise ValueError("{} needs {} entries, got shape {}".format(
+                name, " or ".join(str(k) for k in sorted(set(sizes))),
+                v.shape))
+        bad = np.flatnonzero(~np.isfinite(v))
+        if bad.size:
+            raise ValueError("{} has {} non-finite entries (first: dof {})"
+                             .format(name, bad.size, bad[0]))
+    return m
+
+
 class EnergyBalance:
     """The energies of a run (module docstring), updated per step."""
 

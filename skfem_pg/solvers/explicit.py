@@ -45,7 +45,8 @@ from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       commit, stored_energy, time_functions)
+                       MAX_STEPS, check_run, commit, stored_energy,
+                       time_functions)
 
 
 #: steps before the energy check starts: an impulsive start (a velocity
@@ -176,10 +177,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
             "explicit steps would need a global solve (6.2.3); integrate "
             "it with newmark".format(type(model).__name__,
                                      model.N - n_u, model.N))
-    m = np.asarray(m, dtype=float)
-    if m.shape != (n_u,):
-        raise ValueError("the mass needs one entry per displacement dof "
-                         "({}), got shape {}".format(n_u, m.shape))
+    m = check_run(n_u, n_u, m, t_end, dt, u0, v0)
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     f_of, uD_of = time_functions(model, f_ext, u_D)
     walls = [] if wall is None else (list(wall) if isinstance(
@@ -238,6 +236,13 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
                 F_est, ratio = _gradients(state), 1.0
             step = base / ratio
             times["estimate"] += time.perf_counter() - t1
+        if not (np.isfinite(step) and step > 0) \
+                or steps + (t_end - t) / step > MAX_STEPS:
+            raise DynamicsError(
+                "central differences: the stable step collapsed to {:.3g} "
+                "at t = {:.6g} (step {}): {:.3g} more steps to t_end"
+                .format(step, t, steps, (t_end - t) / step if step else
+                        np.inf), t=t, x=u, v=v, history=hist)
         h = min(step, t_end - t)
         vh = v + 0.5 * h * a
         un = u + h * vh

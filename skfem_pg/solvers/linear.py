@@ -10,6 +10,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from ..errors import SingularSystemError
+
 
 def rigid_body_modes(doflocs, components=None):
     """Rigid-body modes of a vector field with dofs at ``doflocs``
@@ -35,6 +37,36 @@ def rigid_body_modes(doflocs, components=None):
     return np.column_stack(modes)
 
 
+def submatrix(A, I):
+    """``A[I][:, I]`` of a sparse matrix in one pass: the condensed system
+    on the free dofs ``I`` (sorted indices or a boolean mask), as CSR.
+
+    scipy's ``A[I][:, I]`` builds the row selection and then a column
+    selection of it, two copies of the large matrix; this keeps one mask
+    over ``A``'s non-zeros and copies the kept entries once (the 1 M dof
+    scale run: see ``benchmarks/README.md``, "3-D scale run")."""
+    A = A.tocsr()
+    n = A.shape[0]
+    keep = np.zeros(n, dtype=bool)
+    keep[I] = True
+    new = np.full(n, -1, dtype=A.indices.dtype)
+    new[keep] = np.arange(int(keep.sum()), dtype=A.indices.dtype)
+    mask = np.repeat(keep, np.diff(A.indptr))
+    mask &= keep[A.indices]
+    counts = np.zeros(n, dtype=np.int64)
+    full = np.diff(A.indptr) > 0
+    if full.any():
+        counts[full] = np.add.reduceat(mask, A.indptr[:-1][full],
+                                       dtype=np.int64)
+    indices = new[A.indices[mask]]
+    data = A.data[mask]
+    del mask
+    m = int(keep.sum())
+    indptr = np.zeros(m + 1, dtype=A.indptr.dtype)
+    np.cumsum(counts[keep], out=indptr[1:])
+    return sp.csr_matrix((data, indices, indptr), shape=(m, m))
+
+
 def pardiso_available():
     """Whether ``pypardiso`` (Intel MKL PARDISO; ``pip install
     skfem-pg[pardiso]``) can be imported."""
@@ -43,6 +75,74 @@ def pardiso_available():
     except ImportError:
         return False
     return True
+
+
+#: largest relative residual ``|A x - b| / |b|`` a solve may return: a
+#: singular system (too few Dirichlet conditions) comes back from PARDISO
+#: with a residual of order 1 and |x| ~ 1e13; a well-posed system with a
+#: condition number up to about 1e10 stays below it
+RESIDUAL_CHECK = 1e-6
+#: above :data:`RESIDUAL_CHECK`, an ill-conditioned but regular system (a
+#: nearly incompressible one, a saddle point's late Newton increment
+#: whose right-hand side is at round-off: 2.7e-6 with ``|A| |x| / |b|``
+#: = 5e5) is accepted up to this relative residual ...
+RESIDUAL_LIMIT = 1e-3
+#: ... while ``|A| |x| / |b|``, a lower bound of the condition number,
+#: stays below this (a singular matrix solved by SuperLU: 2e16; by PARDISO,
+#: which perturbs its pivots: 2e11 with a relative residual of 11)
+SINGULAR_CONDITION = 1e13
+
+#: names of the rigid-body modes of :func:`rigid_body_modes`, per dimension
+MODE_NAMES = {1: ["translation x"],
+              2: ["translation x", "translation y", "rotation in the x-y plane"],
+              3: ["translation x", "translation y", "translation z",
+                  "rotation about z", "rotation about y",
+                  "rotation about x"]}
+
+
+def check_solution(A, b, x, what="the direct solve"):
+    """Raise :class:`~skfem_pg.errors.SingularSystemError` unless ``x``
+    is finite and ``|A x - b| <= RESIDUAL_CHECK |b|`` (max norms), or
+    within :data:`RESIDUAL_LIMIT` for a system whose condition is not
+    that of a singular matrix (:data:`SINGULAR_CONDITION`); returns
+    ``x``."""
+    if not np.all(np.isfinite(x)):
+        raise SingularSystemError(
+            "{} returned non-finite values ({} of {} entries): the matrix "
+            "({} unknowns) is singular — too few Dirichlet conditions, or a "
+            "mechanism".format(what, int(np.sum(~np.isfinite(x))), len(x),
+                               A.shape[0]))
+    nb = np.abs(b).max() if b.size else 0.0
+    r = np.abs(A @ x - b).max() if b.size else 0.0
+    if r <= RESIDUAL_CHECK * nb:
+        return x
+    kappa = abs(A).sum(axis=1).max() * np.abs(x).max() / max(nb, 1e-300)
+    if r <= RESIDUAL_LIMIT * nb and kappa <= SINGULAR_CONDITION:
+        return x
+    raise SingularSystemError(
+        "{} did not solve the system: relative residual {:.2e}, max |x| "
+        "{:.2e} (|A| |x| / |b| = {:.1e}); the matrix ({} unknowns) is "
+        "singular or nearly so — too few Dirichlet conditions, or a "
+        "mechanism".format(what, r / max(nb, 1e-300), np.abs(x).max(),
+                           kappa, A.shape[0]))
+
+
+def free_rigid_body_modes(A, doflocs, components=None, tol=1e-9):
+    """Names of the rigid-body modes (:data:`MODE_NAMES`) that ``A``
+    (condensed onto the dofs at ``doflocs``) leaves without stiffness:
+    ``|A r| <= tol max|diag A| |r|``.  A constrained mode is resisted at
+    the nodes next to the Dirichlet conditions, at least ``1/sqrt(N)``
+    of that bound."""
+    B = rigid_body_modes(doflocs, components)
+    scale = np.abs(A.diagonal()).max() if A.shape[0] else 0.0
+    names = MODE_NAMES.get(doflocs.shape[0], [])
+    free = []
+    for i in range(B.shape[1]):
+        r = B[:, i]
+        nr = np.linalg.norm(r)
+        if nr > 0 and np.linalg.norm(A @ r) <= tol * scale * nr:
+            free.append(names[i] if i < len(names) else "mode {}".format(i))
+    return free
 
 
 def direct(A, b, ordering="auto", **kwargs):
@@ -70,9 +170,21 @@ def direct(A, b, ordering="auto", **kwargs):
     tetrahedra (3.7k / 9.7k dof) 2.1x / 4.4x faster than ``rcm+mmd`` for
     O1 and 0.8x / 2.7x for PG.  Usable as ``fem.solve(A, b,
     solver=direct)``.
+
+    Every answer is checked (:func:`check_solution`): a singular system
+    raises :class:`~skfem_pg.errors.SingularSystemError` instead of
+    returning a solution with a large residual or non-finite entries.
     """
     A = A.tocsr()
     b = np.asarray(b, dtype=float)
+    with warnings.catch_warnings():  # SuperLU's MatrixRankWarning: the
+        # check below turns a singular matrix into a named error
+        warnings.simplefilter("ignore", spl.MatrixRankWarning)
+        x = _direct(A, b, ordering)
+    return check_solution(A, b, x)
+
+
+def _direct(A, b, ordering):
     if ordering == "auto":
         ordering = "pardiso" if pardiso_available() else "rcm+mmd"
     if ordering == "pardiso":
@@ -169,9 +281,10 @@ DIRECT_LIMIT_PARDISO = {2: 60_000, 3: 150_000}
 #: 6.2 s at 133k (5.7M).  In Newton (``benchmarks/newton_3d.py``) a kept
 #: AMG hierarchy costs PG on tetrahedra 14.5 s per iteration at 74k (11M),
 #: about a factorization's; PG with the thesis recipe on a 40^3/4 hex grid
-#: (55k unknowns, 15M non-zeros) 72 s with AMG (242 CG iterations) against
-#: 14.8 s direct.  Hence 16M.
-DIRECT_NNZ_LIMIT_PARDISO = {3: 16_000_000}
+#: (54k unknowns, 17.0M non-zeros) 45 s of solve per iteration with AMG
+#: (249 CG iterations) against 8.3 s direct.  Hence 24M (on tetrahedra
+#: the unknowns' limit comes first).
+DIRECT_NNZ_LIMIT_PARDISO = {3: 24_000_000}
 
 
 def auto_direct_limit(dim):
@@ -380,6 +493,11 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     ``components``: each condensed dof's component (for the rigid-body
     modes when the free dofs are not whole nodes, e.g. with symmetry
     planes); Newton's method passes them.
+
+    With ``doflocs``, every call first checks that the system resists
+    each rigid-body mode (:func:`free_rigid_body_modes`) and raises
+    :class:`~skfem_pg.errors.SingularSystemError` naming the free ones;
+    every answer is checked by its residual (:func:`check_solution`).
     """
     dim = 2 if doflocs is None else doflocs.shape[0]
     ordering = ("pardiso" if pardiso_available()
@@ -396,6 +514,14 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                     candidates=candidates, components=components)
 
     def solve(A, b, **kwargs):
+        if doflocs is not None and A.shape[0] == doflocs.shape[1]:
+            free = free_rigid_body_modes(A, doflocs, components)
+            if free:
+                raise SingularSystemError(
+                    "the system ({} unknowns) has no stiffness against "
+                    "{}: add Dirichlet conditions (or springs) that hold "
+                    "{}".format(A.shape[0], ", ".join(free),
+                                "it" if len(free) == 1 else "them"))
         k = kind
         if k == "auto":
             small = A.shape[0] <= direct_limit and (

@@ -33,7 +33,8 @@ import scipy.sparse as sp
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       commit, stored_energy, time_functions)
+                       check_run, commit, stored_energy,
+                       time_functions)
 from .static import _condensed_solver, _newton_step
 
 
@@ -116,12 +117,13 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     basis = model.basis
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
-    m = np.asarray(m, dtype=float)
-    if m.shape != (n_u,):
-        raise ValueError("the mass needs one entry per displacement dof "
-                         "({}), got shape {}".format(n_u, m.shape))
+    m = check_run(n_u, N, m, t_end, dt, u0, v0, dt_required=True)
     if not (0 < beta and 0 < gamma):
         raise ValueError("beta and gamma must be positive")
+    if dt_min is not None and not (np.isfinite(dt_min)
+                                   and 0 < dt_min <= dt):
+        raise ValueError("dt_min must lie in (0, dt], got {!r}".format(
+            dt_min))
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
     f_of, uD_of = time_functions(model, f_ext, u_D)
@@ -131,7 +133,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     dt_min = dt / 1024 if dt_min is None else dt_min
     x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
     x = x0.copy()
-    if u0 is not None:
+    if u0 is not None:  # displacements, or all unknowns (check_run)
         u0 = np.asarray(u0, dtype=float)
         x[:u0.shape[0]] = u0
     x[Dd] = uD_of(0.0)[Dd]

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
-from .linear import linear_solver
+from .linear import linear_solver, submatrix
 
 
 class ConvergenceError(RuntimeError):
@@ -142,6 +142,8 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         ``reason``, seconds).
 
     """
+    _check_controls(steps=steps, tol=tol, maxiter=maxiter,
+                    min_step=min_step, load0=load0)
     basis = model.basis
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
@@ -165,12 +167,17 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam = float(load0)
-    if not 0.0 <= lam <= 1.0:
-        raise ValueError("load0 must lie in [0, 1], got {}".format(load0))
     dlam = (1.0 - lam) / steps if lam < 1.0 else 1.0
     prev = None  # (load, u) of the converged step before the last
     history = []
+    attempts, max_attempts = 0, max(MAX_LOAD_STEPS, 4 * steps)
     while lam < 1.0 - 1e-14:
+        attempts += 1
+        if attempts > max_attempts:
+            raise ConvergenceError(
+                "Newton stopped after {} load steps at load factor {:.6g} "
+                "(skfem_pg.solvers.static.MAX_LOAD_STEPS)".format(
+                    max_attempts, lam), load=lam, u=u, history=history)
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
         start = u
@@ -217,6 +224,32 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     return u, history
 
 
+#: most load steps (converged and failed) one :func:`newton` call takes
+#: (or 4 ``steps``): no input makes the load loop run forever
+MAX_LOAD_STEPS = 10_000
+
+
+def _check_controls(steps, tol, maxiter, min_step, load0):
+    """Named errors for load-stepping controls that would divide by zero,
+    loop forever or run backwards."""
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) \
+            or steps < 1:
+        raise ValueError("steps must be a positive integer, got {!r}"
+                         .format(steps))
+    if isinstance(maxiter, bool) \
+            or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
+        raise ValueError("maxiter must be a positive integer, got {!r}"
+                         .format(maxiter))
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError("tol must be a positive number, got {!r}"
+                         .format(tol))
+    if not (np.isfinite(min_step) and 0 < min_step <= 1):
+        raise ValueError("min_step must lie in (0, 1], got {!r}: the step "
+                         "halving needs a floor".format(min_step))
+    if not (np.isfinite(load0) and 0.0 <= load0 <= 1.0):
+        raise ValueError("load0 must lie in [0, 1], got {!r}".format(load0))
+
+
 def _padded(v, n_u, N, what, rest=None):
     """A vector of one entry per displacement dof (the extra fields'
     entries from ``rest``, default zeros, appended) or per unknown;
@@ -232,6 +265,10 @@ def _padded(v, n_u, N, what, rest=None):
                          ", got {}".format(what, n_u, "" if N == n_u else
                                            " or per unknown ({})".format(N),
                                            v.shape[0]))
+    bad = np.nonzero(~np.isfinite(v))[0]
+    if len(bad):
+        raise ValueError("{} has {} non-finite entries (first: dof {} = {})"
+                         .format(what, len(bad), bad[0], v[bad[0]]))
     return v.copy()
 
 
@@ -353,8 +390,8 @@ def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
         rhs = -r[I]
         if pending:
             du[Dd] = du_D
-            rhs = rhs - K[I][:, Dd] @ du_D
-        du[I] = lin(K[I][:, I].tocsr(), rhs)
+            rhs = rhs - (K @ du)[I]
+        du[I] = lin(submatrix(K, I), rhs)
         energy.append(abs(float(np.dot(du[I], rhs))))
         info["t_assemble"] += t1 - t0
         info["t_linear"] += time.perf_counter() - t1
