@@ -282,6 +282,33 @@ def test_options_do_not_leak_into_the_next_solve():
     ksp = dist.petsc.krylov(A, part, options="-mg_levels_ksp_max_it 3")
     assert ksp.getPC().getMGSmoother(1).getTolerances()[3] == 3
     assert smoother_its != 3
+    dist.petsc.release_options(ksp)  # a KSP not solved: its options go
+    assert not PETSc.Options().hasName("skfem_pg_mg_levels_ksp_max_it")
+
+
+def test_bad_options_are_named_and_leave_no_state_behind():
+    """A typo is reported (it used to be dropped unread), a value PETSc
+    rejects raises and the next solve (no options) still works, a solver
+    that does not solve (preonly + none) is caught by the true residual,
+    and a system without Dirichlet conditions is singular (it used to
+    "converge" to 1e13)."""
+    from skfem_pg.errors import SingularSystemError
+    mesh, f, D = cantilever3d(2)
+    part = dist.Partition(mesh, COMM)
+    K = pg.assemble(FORM, part.basis(dim=3))
+    ref, _ = dist.solve(K, part, f, D=D)
+    with pytest.raises(ValueError, match="did not use the options "
+                       "-ksp_tyep"):
+        dist.solve(K, part, f, D=D, options="-ksp_tyep gmres")
+    with pytest.raises(ValueError, match="rejected the options"):
+        dist.solve(K, part, f, D=D, options="-ksp_type cgg")
+    u, _ = dist.solve(K, part, f, D=D)
+    assert rel(u, ref) <= 1e-10
+    with pytest.raises(dist.petsc.KSPError, match="true relative residual"):
+        dist.solve(K, part, f, D=D, options="-ksp_type preonly "
+                   "-pc_type none")
+    with pytest.raises(SingularSystemError, match="6 of its 6"):
+        dist.solve(K, part, f, D=[])
 
 
 def test_parallel_vtu():

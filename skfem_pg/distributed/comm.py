@@ -16,13 +16,37 @@ def mpi():
     return MPI
 
 
+#: where Debian/Ubuntu's python3-petsc4py puts the module: its ``.pth``
+#: looks under ``$PETSC_DIR`` (default ``/usr/lib/petsc``, a link only the
+#: -dev package makes), so a plain ``import petsc4py`` fails without it
+DEBIAN_PETSC4PY = "/usr/lib/petscdir/*/*-real/lib/python3/dist-packages"
+
+
+def _debian_petsc4py():
+    """The newest Debian petsc4py directory, or ``None``."""
+    import glob
+    import os
+    found = [d for d in glob.glob(DEBIAN_PETSC4PY)
+             if os.path.isdir(os.path.join(d, "petsc4py"))]
+    return max(found) if found else None
+
+
 def petsc():
-    """The ``petsc4py.PETSc`` module (initialised)."""
+    """The ``petsc4py.PETSc`` module (initialised).  Finds Debian's
+    prebuilt petsc4py by itself when ``PETSC_DIR`` is not set."""
+    import os
+    import sys
     try:
         from petsc4py import PETSc
     except ImportError as err:
-        raise ImportError("skfem_pg.distributed needs petsc4py: " + EXTRA) \
-            from err
+        where = _debian_petsc4py()
+        if where is None or where in sys.path:
+            raise ImportError("skfem_pg.distributed needs petsc4py: "
+                              + EXTRA) from err
+        os.environ.setdefault(
+            "PETSC_DIR", where[:-len("/lib/python3/dist-packages")])
+        sys.path.append(where)
+        return petsc()
     return PETSc
 
 

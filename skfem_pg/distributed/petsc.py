@@ -194,13 +194,47 @@ def _is_option(token):
         return True
 
 
+#: the options a KSP of :func:`krylov` was given, by its handle: kept in
+#: PETSc's database until :func:`solve_ksp` has run (options such as
+#: ``-ksp_view`` or ``-ksp_converged_reason`` act at the solve), then
+#: checked for use and removed
+_PENDING = {}
+
+
+def _options_used():
+    """PETSc's ``PetscOptionsUsed`` (not wrapped by petsc4py) through
+    ctypes on the loaded libpetsc, or ``None`` where it cannot be found
+    (then unused options go unreported)."""
+    import ctypes
+    try:
+        with open("/proc/self/maps") as fh:
+            libs = sorted({line.split()[-1] for line in fh
+                           if "libpetsc" in line and ".so" in line})
+        f = ctypes.CDLL(libs[0]).PetscOptionsUsed
+    except (OSError, IndexError, AttributeError):
+        return None
+    f.argtypes = [ctypes.c_void_p, ctypes.c_char_p,
+                  ctypes.POINTER(ctypes.c_int)]
+
+    def used(key):
+        flag = ctypes.c_int(0)
+        return f(None, key.encode(), ctypes.byref(flag)) != 0 \
+            or bool(flag.value)
+    return used
+
+
 def krylov(A, part, options=None, symmetric=True, prefix="skfem_pg_",
            rtol=RTOL):
     """A KSP on ``A``: CG (GMRES if not ``symmetric``) with GAMG (drop
     tolerance :data:`GAMG_THRESHOLD`) and the rigid-body near-null space,
     relative tolerance ``rtol``; ``options`` (a PETSc options string or a
     dict, e.g. ``"-ksp_type gmres -pc_type hypre"``) and the command line
-    (``-skfem_pg_ksp_...``, ``-skfem_pg_pc_...``) override the defaults."""
+    (``-skfem_pg_ksp_...``, ``-skfem_pg_pc_...``) override the defaults.
+
+    An option PETSc rejects (``-ksp_type cgg``) raises ``ValueError``
+    naming it; an option nothing reads (a typo, ``-ksp_tyep``) raises
+    after :func:`solve_ksp`; either way this call's options leave PETSc's
+    database, so no later solve inherits them."""
     PETSc = petsc()
     ns = rigid_body_modes(part)
     if ns is not None:
@@ -214,16 +248,76 @@ def krylov(A, part, options=None, symmetric=True, prefix="skfem_pg_",
     ksp.setTolerances(rtol=rtol, atol=0.0, max_it=5000)
     db = PETSc.Options()
     added = _options(prefix, options)
+    ours = []
     if not db.hasName(prefix + "pc_gamg_threshold"):
         # drop weak couplings: on the 3-D Cook (13k dofs) CG took 110
         # iterations and 6.1 s instead of 222 and 10.4 s (PETSc's 0)
         db[prefix + "pc_gamg_threshold"] = GAMG_THRESHOLD
-        added.append(prefix + "pc_gamg_threshold")
-    ksp.setFromOptions()
-    ksp.setUp()  # GAMG reads its levels' options here
-    for key in added:  # this call's options, not the next solve's
+        ours.append(prefix + "pc_gamg_threshold")
+    try:
+        ksp.setFromOptions()
+        ksp.setUp()  # GAMG reads its levels' options here
+    except PETSc.Error as err:
+        for key in added + ours:
+            db.delValue(key)
+        ksp.destroy()
+        raise ValueError("PETSc rejected the options {!r} ({})".format(
+            options, str(err).strip().splitlines()[0])) from None
+    for key in ours:  # the package's default is read at set-up
         db.delValue(key)
+    _PENDING[ksp.handle] = added
     return ksp
+
+
+def release_options(ksp):
+    """Remove the options :func:`krylov` gave ``ksp`` from PETSc's
+    database; raise ``ValueError`` naming those nothing read."""
+    keys = _PENDING.pop(ksp.handle, [])
+    if not keys:
+        return
+    used = _options_used()
+    db = petsc().Options()
+    unused = [k for k in keys if used is not None and not used(k)]
+    for key in keys:
+        db.delValue(key)
+    if unused:
+        raise ValueError(
+            "PETSc did not use the options {} (misspelt, or not for KSP "
+            "{} / PC {})".format(" ".join("-" + k[len("skfem_pg_"):]
+                                           if k.startswith("skfem_pg_")
+                                           else "-" + k for k in unused),
+                                  ksp.getType(), ksp.getPC().getType()))
+
+
+#: largest true relative residual ``|b - A x| / |b|`` a distributed solve
+#: may return (``-ksp_type preonly -pc_type none`` returns 0.99)
+TRUE_RESIDUAL_LIMIT = 1e-4
+
+
+def check_rigid_body_modes(A, part, tol=1e-9):
+    """Raise :class:`~skfem_pg.errors.SingularSystemError` if ``A``
+    (Dirichlet rows and columns lifted) leaves rigid-body modes without
+    stiffness (``|A r| <= tol max|diag A| |r|``), saying how many."""
+    from ..errors import SingularSystemError
+    ns = rigid_body_modes(part)
+    if ns is None:
+        return
+    diag = A.getDiagonal()
+    scale = max(abs(diag.max()[1]), abs(diag.min()[1]))
+    diag.destroy()
+    y = A.createVecLeft()
+    free = 0
+    vecs = ns.getVecs()
+    for r in vecs:
+        A.mult(r, y)
+        if y.norm() <= tol * scale * r.norm():
+            free += 1
+    y.destroy()
+    if free:
+        raise SingularSystemError(
+            "the distributed system has no stiffness against {} of its {} "
+            "rigid-body modes: add Dirichlet conditions that hold them"
+            .format(free, len(vecs)))
 
 
 class KSPError(RuntimeError):
@@ -245,17 +339,34 @@ def solve_ksp(ksp, b, part):
     preconditioner; raise naming the reason when it diverges.  Returns
     ``(x, iterations)``: all iterations, CG's included."""
     x = empty_vector(part)
-    ksp.solve(b, x)
-    its = ksp.getIterationNumber()
-    reason = ksp.getConvergedReason()
-    if reason in INDEFINITE and ksp.getType() == "cg":
-        ksp.setType("gmres")
-        ksp.setGMRESRestart(200)
-        ksp.setTolerances(max_it=GMRES_FALLBACK_ITERATIONS)
-        x.set(0.0)
+    try:
         ksp.solve(b, x)
-        its += ksp.getIterationNumber()
+        its = ksp.getIterationNumber()
         reason = ksp.getConvergedReason()
+        if reason in INDEFINITE and ksp.getType() == "cg":
+            ksp.setType("gmres")
+            ksp.setGMRESRestart(200)
+            ksp.setTolerances(max_it=GMRES_FALLBACK_ITERATIONS)
+            x.set(0.0)
+            ksp.solve(b, x)
+            its += ksp.getIterationNumber()
+            reason = ksp.getConvergedReason()
+    finally:
+        release_options(ksp)
+    if reason >= 0:  # converged by its own measure: check the true one
+        A = ksp.getOperators()[0]
+        r = b.duplicate()
+        A.mult(x, r)
+        r.aypx(-1.0, b)
+        nb = b.norm()
+        rel = r.norm() / nb if nb > 0 else r.norm()
+        r.destroy()
+        if not rel <= TRUE_RESIDUAL_LIMIT:
+            raise KSPError(
+                "PETSc KSP {} with PC {} stopped after {} iterations with a "
+                "true relative residual {:.3g} > {:g}: not a solution "
+                "(options?)".format(ksp.getType(), ksp.getPC().getType(),
+                                    its, rel, TRUE_RESIDUAL_LIMIT), reason)
     if reason < 0:
         raise KSPError(
             "PETSc KSP {} with PC {} diverged (reason {}) after {} "

@@ -78,13 +78,16 @@ def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True,
     b = pt.from_serial(np.zeros(part.N) if f is None else f, part)
     rows, values = _dirichlet(part, D, u_D)
     _lifted(A, b, rows, values, part)
+    pt.check_rigid_body_modes(A, part)
     t1 = time.perf_counter()
     ksp = pt.krylov(A, part, options, symmetric=symmetric, rtol=rtol)
-    x, its = pt.solve_ksp(ksp, b, part)
+    try:
+        x, its = pt.solve_ksp(ksp, b, part)
+    finally:
+        ksp.destroy()
     _impose(x, rows, values)  # the Krylov solve is inexact there
     t2 = time.perf_counter()
     u = part.gather(x)
-    ksp.destroy()
     A.destroy()
     return u, {"iterations": its, "t_assemble": t1 - t0,
                "t_linear": t2 - t1}
@@ -223,6 +226,8 @@ def _newton_step(model, part, U0, lam, F, rows, prescribed, tol, maxiter,
         inc = (prescribed - U.getValues(rows) if pending
                else np.zeros(len(rows)))
         _lifted(K, R, rows, inc, part)
+        if it == 0:
+            pt.check_rigid_body_modes(K, part)
         t1 = time.perf_counter()
         ksp = pt.krylov(K, part, options, rtol=rtol)
         try:

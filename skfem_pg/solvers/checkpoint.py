@@ -1,31 +1,139 @@
-"""Checkpoints: the unknowns, the load factor reached and the committed
-history of a model in one ``.npz`` file, so that a run can be resumed
-(``newton(model, ..., u0=x, load0=load)`` after :func:`load`)."""
+"""Checkpoints: a run's state in one ``.npz`` file, so that it can be
+resumed after a crash and end where the uninterrupted run ends.
+
+* :func:`save` / :func:`load`: the unknowns, the load factor reached and
+  the committed history of a model, plus any further named state (the
+  drivers store their step controller: :func:`~skfem_pg.solvers.newton`'s
+  step and predictor, the integrators' time, velocities, accelerations and
+  energy accounts).
+* Writes are atomic: a temporary file in the same directory, then
+  ``os.replace``; a kill during the write leaves the previous checkpoint
+  intact.
+* A checkpoint carries the fingerprint of its model (:func:`fingerprint`:
+  formulation, material and its parameters, basis, the particle or node
+  positions, counts); loading it into another model raises a
+  ``ValueError`` naming what differs.
+* ``path`` may be given with or without its ``.npz`` suffix.
+"""
+import hashlib
+import json
+import os
+import tempfile
+import time
+import zipfile
+
 import numpy as np
 
+#: bump when the stored content changes meaning
+FORMAT = 2
 
-def save(path, model, x, load=1.0):
-    """Write ``x`` (all unknowns of ``model``), the load factor ``load``
-    and the committed history of a plastic ``model`` to ``path``."""
-    arrays = {"x": np.asarray(x, dtype=float), "load": float(load)}
+
+def _path(path):
+    path = os.fspath(path)
+    return path if path.endswith(".npz") else path + ".npz"
+
+
+def _digest(a):
+    a = np.ascontiguousarray(np.asarray(a, dtype=float))
+    return "{} {}".format(a.shape, hashlib.sha1(a.tobytes()).hexdigest()[:16])
+
+
+def _describe(value):
+    if isinstance(value, np.ndarray):
+        return _digest(value) if value.size > 8 else value.tolist()
+    if isinstance(value, (float, np.floating)):
+        return float(value).hex()
+    if isinstance(value, (int, str, bool, type(None), np.integer)):
+        return value if not isinstance(value, np.integer) else int(value)
+    if hasattr(value, "__dict__"):
+        return {"type": type(value).__qualname__,
+                **{k: _describe(v) for k, v in sorted(vars(value).items())
+                   if not k.startswith("_")}}
+    return repr(value)
+
+
+def fingerprint(model):
+    """What a checkpoint must match, as ``{field: text}``: the
+    formulation, its material (type and parameters, full precision), the
+    basis (family basis: its thesis code; FE: the element), the node or
+    particle positions (a hash) and the number of unknowns."""
+    basis = model.basis
+    material = getattr(model, "material", None)
+    material = getattr(material, "material", material)  # a History's law
+    if hasattr(basis, "layout"):
+        from ..naming import name_of
+        try:
+            kind = name_of(basis)
+        except (KeyError, ValueError):
+            kind = "FamilyBasis {}".format(getattr(basis, "shape", ""))
+    else:
+        kind = type(getattr(basis, "elem", basis)).__name__
+    return {"formulation": type(model).__qualname__,
+            "material": json.dumps(_describe(material), sort_keys=True),
+            "basis": kind,
+            "positions": _digest(basis.doflocs),
+            "unknowns": str(getattr(model, "N", basis.N))}
+
+
+def save(path, model, x, load=1.0, **state):
+    """Write ``x`` (all unknowns of ``model``), the load factor (or time)
+    ``load``, the committed history of a plastic ``model``, the model's
+    :func:`fingerprint` and ``state`` (further arrays or numbers, e.g. a
+    driver's step controller) to ``path`` atomically.  Returns the path
+    written (with ``.npz``)."""
+    path = _path(path)
+    arrays = {"x": np.asarray(x, dtype=float), "load": float(load),
+              "format": FORMAT,
+              "fingerprint": json.dumps(fingerprint(model), sort_keys=True)}
     h = getattr(model, "history", None)
     saved = None if h is None else h.save()
     for k, v in (saved or {}).items():
         arrays["history_" + k] = v
-    np.savez(path, **arrays)
+    for k, v in state.items():
+        arrays["state_" + k] = v
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=d, prefix=".checkpoint-",
+                               suffix=".tmp.npz")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path
 
 
-def load(path, model):
+def load(path, model, state=False):
     """Read a checkpoint of :func:`save` into ``model`` (its history) and
-    return ``(x, load)``; a checkpoint of another model (number of
-    unknowns, history points) raises."""
-    with np.load(path) as f:
-        x, lam = f["x"], float(f["load"])
-        saved = {k[len("history_"):]: f[k] for k in f.files
-                 if k.startswith("history_")}
-    if x.shape != (model.N,):
-        raise ValueError("checkpoint {} has {} unknowns, the model {}".format(
-            path, x.shape[0], model.N))
+    return ``(x, load)``, or ``(x, load, state)`` with ``state=True`` (the
+    dict of further named state).  A checkpoint of another model — its
+    :func:`fingerprint` differs: formulation, material, basis, positions,
+    unknowns — raises ``ValueError`` naming the difference, and so does an
+    unreadable file (naming its path)."""
+    path = _path(path)
+    try:
+        with np.load(path) as f:
+            data = {k: f[k] for k in f.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
+        raise ValueError("checkpoint {} cannot be read ({}: {})".format(
+            path, type(err).__name__, err)) from None
+    fmt = int(data["format"]) if "format" in data else 1
+    if fmt != FORMAT:
+        raise ValueError("checkpoint {} has format {}, this version reads "
+                         "{}".format(path, fmt, FORMAT))
+    mine, theirs = fingerprint(model), json.loads(str(data["fingerprint"]))
+    for k in ("unknowns", "formulation", "basis", "material", "positions"):
+        if mine[k] != theirs.get(k):
+            raise ValueError(
+                "checkpoint {} was written for another model — {}: {} in "
+                "the checkpoint, {} in this model".format(
+                    path, k, theirs.get(k), mine[k]))
+    x, lam = data["x"], float(data["load"])
+    saved = {k[len("history_"):]: v for k, v in data.items()
+             if k.startswith("history_")}
     h = getattr(model, "history", None)
     if saved and h is None:
         raise ValueError("checkpoint {} holds a history, the model's "
@@ -37,4 +145,49 @@ def load(path, model):
                              "has {}".format(path, saved["alpha"].shape,
                                              h.committed["alpha"].shape))
         h.restore(saved or None)
-    return x, lam
+    if not state:
+        return x, lam
+    extra = {k[len("state_"):]: (v[()] if v.ndim == 0 else v)
+             for k, v in data.items() if k.startswith("state_")}
+    return x, lam, extra
+
+
+class Every:
+    """Where and how often a driver writes its checkpoint: ``path``, every
+    ``steps`` converged steps and/or every ``seconds`` of wall time (the
+    first that comes); neither: every step.  Drivers take it as
+    ``checkpoint=Every("run.npz", seconds=600)`` (a plain path means every
+    step)."""
+
+    def __init__(self, path, steps=None, seconds=None):
+        if steps is not None and not (isinstance(steps, (int, np.integer))
+                                      and steps >= 1):
+            raise ValueError("steps must be a positive integer, got {!r}"
+                             .format(steps))
+        if seconds is not None and not (np.isfinite(seconds)
+                                        and seconds > 0):
+            raise ValueError("seconds must be a positive number, got {!r}"
+                             .format(seconds))
+        self.path, self.steps, self.seconds = _path(path), steps, seconds
+        self._last_step, self._last_time = 0, None
+
+    @classmethod
+    def of(cls, spec):
+        """``None``, a path or an :class:`Every`, as an :class:`Every`."""
+        if spec is None or isinstance(spec, cls):
+            return spec
+        return cls(spec)
+
+    def save(self, count, model, x, load, **state):
+        """:func:`save` if due at converged step number ``count``."""
+        now = time.monotonic()
+        if self._last_time is None:
+            self._last_time = now
+        due = (self.steps is None and self.seconds is None) or (
+            self.steps is not None and count - self._last_step >= self.steps
+        ) or (self.seconds is not None
+              and now - self._last_time >= self.seconds)
+        if due:
+            save(self.path, model, x, load, **state)
+            self._last_step, self._last_time = count, now
+        return due

@@ -23,6 +23,7 @@ For Newmark's average acceleration (β = 1/4, γ = 1/2) the trapezoidal
 works make the balance exact for a linear problem; for central
 differences it holds to :math:`O(\Delta t^2)` with no drift.
 """
+import json
 import sys
 import time
 from dataclasses import dataclass, field
@@ -135,6 +136,18 @@ class EnergyBalance:
                                                    du[held])
             self.D_c -= float(w)
 
+    #: the accounts a checkpoint keeps
+    ACCOUNTS = ("T0", "W_int", "W_ext", "W_D", "D_c", "scale")
+
+    def accounts(self):
+        """The running accounts, for a checkpoint."""
+        return {"energy_" + k: getattr(self, k) for k in self.ACCOUNTS}
+
+    def restore(self, saved):
+        """Set the accounts from :meth:`accounts` (a resumed run)."""
+        for k in self.ACCOUNTS:
+            setattr(self, k, float(saved["energy_" + k]))
+
     def record(self, t, v, free, stored=None):
         """The energies at time ``t`` as a dict (with the balance
         error, absolute and relative)."""
@@ -163,6 +176,16 @@ class DynamicsError(RuntimeError):
         super().__init__(message)
         self.t, self.x, self.v = t, x, v
         self.history = history or []
+
+
+def history_text(hist):
+    """The records of a run as JSON text (a checkpoint keeps them)."""
+    return json.dumps(hist, default=float)
+
+
+def history_of(text):
+    """The records of :func:`history_text`."""
+    return json.loads(str(text))
 
 
 def commit(model, state, t, x, v, hist):

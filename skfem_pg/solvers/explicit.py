@@ -44,9 +44,10 @@ from ..dofs import as_dofs
 from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
+from .checkpoint import Every, load as load_checkpoint
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       MAX_STEPS, check_run, commit, stored_energy,
-                       time_functions)
+                       MAX_STEPS, check_run, commit, history_of,
+                       history_text, stored_energy, time_functions)
 
 
 #: steps before the energy check starts: an impulsive start (a velocity
@@ -131,7 +132,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
                        u0=None, v0=None, dt=None, safety=0.8,
                        estimate_every=100, wall=None, callback=None,
                        output_every=None, max_energy_error=0.05,
-                       verbose=True):
+                       verbose=True, checkpoint=None, resume=None):
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by central differences.
 
@@ -161,6 +162,14 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     max_energy_error
         Stop with :class:`DynamicsError` when the relative energy balance
         error exceeds this (checked from step :data:`STARTUP_STEPS` on).
+    checkpoint, resume
+        A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
+        ``Every("taylor.npz", seconds=600)``) to write the run's state to
+        (time, displacements, velocities, accelerations, internal force,
+        held dofs, the step estimate and the deformation it was made at,
+        energy accounts, records, the model's history; atomically); a path
+        to resume such a run from: it then ends where the uninterrupted
+        run ends, to round-off.
 
     Returns
     -------
@@ -226,7 +235,21 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     base = step  # the estimate's step, before the configuration scaling
     if output_every is None:
         output_every = max(1, int(round(t_end / step / 20)))
-    output()
+    if resume is None:
+        output()
+    else:
+        u, t, saved = load_checkpoint(resume, model, state=True)
+        v, a, fi = saved["v"], saved["a"], saved["f_int"]
+        held = saved["held"].astype(bool)
+        steps, step, base = int(saved["steps"]), float(saved["step"]), \
+            float(saved["base"])
+        output_every = int(saved["output_every"])
+        F_est = saved.get("F_est")
+        energy.restore(saved)
+        hist[:] = history_of(saved["records"])
+        state = _evaluate(model, u, t, hist, v)
+        fe = f_of(t)
+    every = Every.of(checkpoint)
     while t < t_end * (1 - 1e-12):
         if dt is None and steps:
             t1 = time.perf_counter()
@@ -294,6 +317,12 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
             output(force_progress=t >= t_end * (1 - 1e-12))
         else:
             progress(t, h, steps, rec_err)
+        if every is not None:
+            every.save(steps, model, u, t, v=v, a=a, f_int=fi,
+                       held=held.astype(float), steps=steps, step=step,
+                       base=base, output_every=output_every,
+                       records=history_text(hist), **energy.accounts(),
+                       **({} if F_est is None else {"F_est": F_est}))
     times["total"] = time.perf_counter() - t_start
     return Trajectory(u, v, a, t, hist, steps, times)
 

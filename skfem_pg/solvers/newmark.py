@@ -32,9 +32,10 @@ import scipy.sparse as sp
 
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
+from .checkpoint import Every, load as load_checkpoint
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       check_run, commit, stored_energy,
-                       time_functions)
+                       check_run, commit, history_of, history_text,
+                       stored_energy, time_functions)
 from .static import _condensed_solver, _newton_step
 
 
@@ -79,7 +80,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
             v0=None, beta=0.25, gamma=0.5, dt_min=None, tol=1e-8,
             maxiter=20, solver="auto", wall=None, callback=None,
             output_every=1, verbose=True, max_contact_passes=20,
-            line_search=False):
+            line_search=False, checkpoint=None, resume=None):
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by Newmark's method (module docstring).
 
@@ -106,6 +107,13 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     callback
         ``callback(t, x, v, record)`` at the start and every
         ``output_every`` converged steps, and at the end.
+    checkpoint, resume
+        A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
+        ``Every("run.npz", seconds=600)``) to write the run's state to
+        after converged steps (time, unknowns, velocities, accelerations,
+        internal force, step size, held dofs, energy accounts, records,
+        the model's history; atomically); a path to resume such a run
+        from: it then ends where the uninterrupted run ends, to round-off.
 
     Returns
     -------
@@ -150,8 +158,19 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     energy.D_c += hold_initial(walls, cand, x, v, a, m, held)
     hist = []
     t, steps, step, cuts = 0.0, 0, float(dt), 0
+    if resume is not None:
+        x, t, saved = load_checkpoint(resume, model, state=True)
+        v, a, fi = saved["v"], saved["a"], saved["f_int"]
+        held = saved["held"].astype(bool)
+        step, steps, cuts = float(saved["step"]), int(saved["steps"]), \
+            int(saved["cuts"])
+        energy.restore(saved)
+        hist = history_of(saved["records"])
+        state = model.state(x)
+        fe = f_of(t)
     progress = Progress(t_end, verbose)
     solvers = {}
+    every = Every.of(checkpoint)
 
     def output(info=None, final=False):
         t1 = time.perf_counter()
@@ -166,7 +185,8 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
             callback(t, x, v, rec)
         times["output"] += time.perf_counter() - t1
 
-    output()
+    if resume is None:
+        output()
     while t < t_end * (1 - 1e-12):
         h = min(step, t_end - t)
         ok, res = _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of,
@@ -199,6 +219,11 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         final = t >= t_end * (1 - 1e-12)
         if steps % output_every == 0 or final:
             output(info, final)
+        if every is not None:
+            every.save(steps, model, x, t, v=v, a=a, f_int=fi,
+                       held=held.astype(float), step=step, steps=steps,
+                       cuts=cuts, records=history_text(hist),
+                       **energy.accounts())
     times["total"] = sum(times.values())
     return Trajectory(x, v, a, t, hist, steps, times)
 

@@ -19,6 +19,7 @@ import numpy as np
 
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
+from .checkpoint import Every, load as load_checkpoint
 from .linear import linear_solver, submatrix
 
 
@@ -65,7 +66,7 @@ def _condensed_solver(kind, basis, I, extra_fields=False):
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
            tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
            adaptive=True, predictor=True, verbose=True, load0=0.0,
-           callback=None, line_search=False):
+           callback=None, line_search=False, checkpoint=None, resume=None):
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
@@ -125,6 +126,16 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         step: its unknowns, load factor and internal force vector (the
         reactions at the Dirichlet dofs) — output of load–displacement
         curves and time series without a second evaluation.
+    checkpoint
+        A path (or :class:`~skfem_pg.solvers.checkpoint.Every`): after
+        every converged step (or as often as it says) the unknowns, the
+        load factor, the committed history and the step controller (the
+        next step, the predictor's previous state) are written there
+        atomically (:mod:`~skfem_pg.solvers.checkpoint`).
+    resume
+        A path written by ``checkpoint``: start from it (instead of
+        ``u0`` / ``load0``); the run then ends where the uninterrupted run
+        ends, to round-off.  A checkpoint of another model raises.
     line_search
         ``True``: halve an increment whose iterate fails, or a later
         one that raises the residual (at most
@@ -169,7 +180,16 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     lam = float(load0)
     dlam = (1.0 - lam) / steps if lam < 1.0 else 1.0
     prev = None  # (load, u) of the converged step before the last
+    if resume is not None:
+        if u0 is not None or load0:
+            raise ValueError("resume= starts from its checkpoint: give "
+                             "neither u0 nor load0 with it")
+        u, lam, saved = load_checkpoint(resume, model, state=True)
+        dlam = float(saved.get("step", dlam))
+        if "prev_x" in saved:
+            prev = (float(saved["prev_load"]), saved["prev_x"])
     history = []
+    every = Every.of(checkpoint)
     attempts, max_attempts = 0, max(MAX_LOAD_STEPS, 4 * steps)
     while lam < 1.0 - 1e-14:
         attempts += 1
@@ -206,10 +226,14 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
-            if callback is not None:
-                callback(u, lam, f_int)
             if adaptive and len(info["residuals"]) <= 5:
                 dlam = min(2 * dlam, 1.0)
+            if every is not None:  # before the callback, which may fail
+                every.save(len(history), model, u, lam, step=dlam,
+                           **({} if prev is None else
+                              {"prev_load": prev[0], "prev_x": prev[1]}))
+            if callback is not None:
+                callback(u, lam, f_int)
             continue
         dlam = (target - lam) / 2  # the step tried (clipped at 1), halved
         if dlam < min_step or not adaptive:

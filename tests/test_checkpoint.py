@@ -1,0 +1,141 @@
+"""Checkpoints (issue #28): atomic writes, a fingerprint that refuses
+another model, and resumed runs — static (adaptive steps), Newmark and
+central differences — that end where the uninterrupted run ends."""
+import os
+
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg.formulations import model_for
+from skfem_pg.materials import J2Plasticity, LinearElastic, NeoHookeIsoVol
+from skfem_pg.solvers import (central_difference, checkpoint, lumped_mass,
+                              newmark, newton)
+
+STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,
+                                delta=16.93)
+
+
+def strip(nx=8, ny=2):
+    return fem.MeshQuad.init_tensor(
+        np.linspace(0, 4, nx + 1), np.linspace(0, 1, ny + 1)
+    ).with_boundaries({"left": lambda x: x[0] == 0,
+                       "right": lambda x: x[0] == 4})
+
+
+class Stop(Exception):
+    pass
+
+
+def stop_after(n):
+    """A callback that kills the run after ``n`` converged steps."""
+    count = [0]
+
+    def callback(*args):
+        count[0] += 1
+        if count[0] == n:
+            raise Stop
+    return callback
+
+
+def test_an_adaptive_plastic_run_resumes_to_round_off(tmp_path):
+    mesh = strip()
+    basis = pg.FamilyBasis(mesh, dim=2)
+    D = basis.get_dofs(["left", "right"]).all()
+    uD = np.zeros(basis.N)
+    uD[basis.get_dofs("right").all("u^1")] = 0.12
+    kw = dict(D=D, u_D=uD, steps=8, verbose=False)
+    full = model_for("Unl", basis, STEEL)
+    x_full, hist_full = newton(full, None, **kw)
+    ck = str(tmp_path / "run")  # no suffix: ".npz" is added
+    part = model_for("Unl", basis, STEEL)
+    with pytest.raises(Stop):
+        newton(part, None, checkpoint=ck, callback=stop_after(3), **kw)
+    resumed = model_for("Unl", basis, STEEL)
+    x, hist = newton(resumed, None, resume=ck, **kw)
+    assert len(hist) == len(hist_full) - 3  # the same steps after it
+    assert np.abs(x - x_full).max() <= 1e-12 * np.abs(x_full).max()
+    assert np.abs(resumed.history.alpha() - full.history.alpha()).max() \
+        <= 1e-12
+
+
+def test_a_checkpoint_of_another_model_is_refused_by_name(tmp_path):
+    mesh = strip()
+    basis = pg.FamilyBasis(mesh, dim=2)
+    x = np.zeros(basis.N)
+    path = checkpoint.save(tmp_path / "a", model_for("Unl", basis, STEEL),
+                           x, 0.5)
+    assert path.endswith("a.npz")
+    other = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.2)
+    cases = [
+        (model_for("UnlP0", basis, STEEL), "formulation"),
+        (model_for("Unl", basis, other), "material"),
+        (model_for("Unl", pg.FamilyBasis(mesh, dim=2, vc_boundary="p"),
+                   STEEL), "basis"),
+        (model_for("Unl", pg.FamilyBasis(mesh.translated((1.0, 0.0)),
+                                         dim=2), STEEL), "positions"),
+        (model_for("Unl", pg.FamilyBasis(strip(9), dim=2), STEEL),
+         "unknowns")]
+    for model, field in cases:
+        with pytest.raises(ValueError, match="another model — " + field):
+            checkpoint.load(tmp_path / "a", model)
+    x0, lam = checkpoint.load(tmp_path / "a.npz",
+                              model_for("Unl", basis, STEEL))
+    assert lam == 0.5 and np.array_equal(x0, x)
+
+
+def test_a_failed_write_keeps_the_previous_checkpoint(tmp_path, monkeypatch):
+    basis = pg.FamilyBasis(strip(), dim=2)
+    model = model_for("Unl", basis, STEEL)
+    checkpoint.save(tmp_path / "c", model, np.ones(basis.N), 0.25)
+
+    def killed(fh, **arrays):
+        fh.write(b"PK\x03\x04 half a zip")
+        raise KeyboardInterrupt
+    monkeypatch.setattr(np, "savez", killed)
+    with pytest.raises(KeyboardInterrupt):
+        checkpoint.save(tmp_path / "c", model, np.zeros(basis.N), 0.5)
+    monkeypatch.undo()
+    x, lam = checkpoint.load(tmp_path / "c", model)
+    assert lam == 0.25 and np.all(x == 1.0)
+    assert os.listdir(tmp_path) == ["c.npz"]  # no temporary left
+    (tmp_path / "d.npz").write_bytes(b"PK\x03\x04 truncated")
+    with pytest.raises(ValueError, match="d.npz cannot be read"):
+        checkpoint.load(tmp_path / "d", model)
+
+
+def _bar():
+    mesh = strip(10, 2)
+    basis = pg.FamilyBasis(mesh, dim=2)
+    D = basis.get_dofs("left").all()
+    v0 = np.zeros(basis.N)
+    v0[0::2] = 0.05 * basis.doflocs[0, 0::2]
+    return basis, D, v0
+
+
+@pytest.mark.parametrize("integrator", ["newmark", "central"])
+def test_a_dynamic_run_resumes_to_round_off(tmp_path, integrator):
+    basis, D, v0 = _bar()
+    material = NeoHookeIsoVol(40.0, 80.0)
+    m = lumped_mass(basis, 1.0)
+
+    def run(**kw):
+        model = model_for("Unl", basis, material)
+        if integrator == "newmark":
+            return newmark(model, m, 0.6, 0.02, D=D, v0=v0, verbose=False,
+                           **kw)
+        return central_difference(model, m, 0.6, D=D, v0=v0, verbose=False,
+                                  **kw)
+    full = run()
+    ck = checkpoint.Every(tmp_path / "dyn", steps=5)
+    with pytest.raises(Stop):  # at step 11; the checkpoint of step 10
+        run(checkpoint=ck, callback=stop_after(12))
+    assert os.path.exists(tmp_path / "dyn.npz")
+    resumed = run(resume=tmp_path / "dyn")
+    assert resumed.steps == full.steps and resumed.t == full.t
+    for a, b in ((resumed.x, full.x), (resumed.v, full.v)):
+        assert np.abs(a - b).max() <= 1e-12 * np.abs(b).max()
+    e_full, e = full.series("relative_error"), resumed.series(
+        "relative_error")
+    assert len(e) == len(e_full) and np.abs(e - e_full).max() <= 1e-12
