@@ -288,3 +288,29 @@ def test_no_warning_on_ordinary_input(strip):
         warnings.simplefilter("error")
         u, _ = newton(model, f, D=D, verbose=False)
     assert np.isfinite(u).all() and np.abs(u).max() > 0
+
+
+# -- bare errors that now name their culprit ------------------------------
+
+def test_meshes_a_particle_set_cannot_come_from_are_named():
+    m = fem.MeshQuad().refined(2)
+    unused = fem.MeshQuad(np.hstack([m.p, [[5.0], [5.0]]]), m.t)
+    with pytest.raises(pg.errors.ParticleError,
+                       match=r"belong to no element, first particle 25 at "
+                       r"\(5, 5\)"):
+        pg.FamilyBasis(unused, dim=2)
+    tri = fem.MeshTri().refined(2)
+    flat3d = fem.MeshTri(np.vstack([tri.p, np.zeros(tri.nvertices)]), tri.t)
+    with pytest.raises(pg.errors.ParticleError, match="2-D elements but 3 "
+                       "coordinates"):
+        pg.FamilyBasis(flat3d, dim=2)
+    with pytest.raises(ValueError, match="dim=3 components on 2-D"):
+        pg.FamilyBasis(m, dim=3)
+
+
+def test_u1sunl_on_a_petrov_basis_says_why():
+    mesh = _strip()
+    sc = Scene("ppg", mesh, ELASTIC, clamped=["left"],
+               tractions={"right": [0.0, 0.01]})
+    with pytest.raises(ValueError, match="got a PPG1 MTE1 basis"):
+        sc.solve("VCPPG U1SUnl")

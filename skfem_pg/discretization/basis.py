@@ -222,6 +222,12 @@ class FamilyBasis(AbstractBasis):
             raise TypeError("particles must be a skfem_pg.Particles or a "
                             "scikit-fem mesh, got {}"
                             .format(type(particles).__name__))
+        if dim is not None and (isinstance(dim, bool) or dim
+                                != particles.dim):
+            raise ValueError(
+                "dim={!r} components on {}-D particles: a vector field "
+                "(displacements) has dim={}, a scalar field dim=None"
+                .format(dim, particles.dim, particles.dim))
         if method not in METHODS:
             raise NotImplementedError(
                 "method {!r} is not available; this version implements {}"

@@ -201,6 +201,19 @@ class Particles:
 
         """
         e1, e0 = linear_elements(mesh)
+        dim = mesh.refdom.dim() if hasattr(mesh.refdom, "dim") else None
+        if dim is not None and mesh.p.shape[0] != dim:
+            raise ParticleError(
+                "{} has {}-D elements but {} coordinates per vertex: give "
+                "it (d, n) = ({}, n) points (drop the extra coordinate)"
+                .format(type(mesh).__name__, dim, mesh.p.shape[0], dim))
+        unused = np.setdiff1d(np.arange(mesh.p.shape[1]), mesh.t)
+        if len(unused) and kind == "vertices":
+            raise ParticleError(
+                "{} vertex(es) belong to no element, first {}: remove them "
+                "(e.g. mesh.remove_unused_nodes())".format(
+                    len(unused), describe_particle(unused[0],
+                                                   mesh.p[:, unused[0]])))
         subset = None if elements is None else \
             np.asarray(mesh.normalize_elements(elements), dtype=np.int64)
         tind = np.arange(mesh.nelements) if subset is None else subset

@@ -274,9 +274,13 @@ class U1SUnl(_MasterModel):
     def __init__(self, basis, material):
         if not isinstance(basis, FamilyBasis) or basis.shape != "MTE1" \
                 or basis.is_petrov:
+            got = ("a {} {} basis".format(basis.method, basis.shape)
+                   if isinstance(basis, FamilyBasis)
+                   else type(basis).__name__)
             raise ValueError("U1SUnl stabilizes with the full Unl "
-                             "integration: it needs a PBG MTE1 basis, got "
-                             "{!r}".format(getattr(basis, "shape", basis)))
+                             "integration of a Bubnov-Galerkin basis: it "
+                             "needs a PBG MTE1 basis, got {} (no PPG form "
+                             "of U1SUnl is in Table 7.1)".format(got))
         super().__init__(basis, under_integrated(basis), material)
         self._E2 = Elements(basis)
 
