@@ -139,9 +139,11 @@ def test_least_squares_master_derivatives(d):
     k, eps = 5, 1e-6
     others = mem[k][mask[k]][1:]
     xk = p.x[:, fam.masters[k]]
+    # ls_values takes offsets in units of the family radius
+    h = np.linalg.norm(p.x[:, others].T - xk, axis=1).max()
 
     def values(pt):
-        N, _ = ls.ls_values((p.x[:, others].T - pt)[None],
+        N, _ = ls.ls_values(((p.x[:, others].T - pt) / h)[None],
                             p.volumes[others][None])
         return N[0]
     fd = np.array([(values(xk + eps * e) - values(xk - eps * e)) / (2 * eps)

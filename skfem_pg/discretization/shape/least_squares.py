@@ -16,8 +16,8 @@ position.
 """
 import numpy as np
 
-from .common import (FamilyGeometry, chunks, weights, inverse_spd,
-                     raise_singular)
+from .common import (BOND_FLOOR, FamilyGeometry, chunks, weights,
+                     inverse_spd, raise_singular)
 
 
 def _basis(D, order):
@@ -36,7 +36,7 @@ def ls_values(D, V, n=1, order=1):
     particles of evaluation points ``x``: :math:`N^i = \omega^i V^i
     p^i\cdot M^{-1} e_0`.  Offsets of length 0 get weight 0.  Returns
     ``(N, singular)``."""
-    W = weights((D ** 2).sum(-1), n) * V
+    W = weights((D ** 2).sum(-1), n, floor=True) * V
     p = _basis(D, order)
     M = np.swapaxes(W[..., None] * p, -1, -2) @ p
     Minv, singular = inverse_spd(M)
@@ -97,7 +97,7 @@ def master_fits(x, volumes, fam, n=1, order=1, moving=False):
     for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         r2 = (geo.D0 ** 2).sum(-1)
-        W = weights(r2, n) * geo.V
+        W = weights(r2, n, floor=True) * geo.V
         p = _basis(geo.D0, order)
         M = np.swapaxes(W[..., None] * p, -1, -2) @ p
         Minv, singular = inverse_spd(M)
@@ -121,8 +121,9 @@ def _mls1_master_gradients(D, r2, W, p, Minv, n):
     d = D.shape[-1]
     a0 = Minv[..., :, 0]  # M^{-1} e0, (nf, q)
     pa = (p * a0[:, None, :]).sum(-1)  # p^i·M^{-1}e0, (nf, m)
+    # a weight held at the bond floor does not move with the point
     safe = np.where(r2 > 0, r2, 1.0)
-    dW = np.where(r2 > 0, 2.0 * n * W / safe, 0.0)[..., None] * D  # (nf,m,d)
+    dW = np.where(r2 > BOND_FLOOR, 2.0 * n * W / safe, 0.0)[..., None] * D
     g = np.empty(D.shape)
     for a in range(d):
         Ea = np.zeros(p.shape[-1])
@@ -241,11 +242,12 @@ def mls1_hessian_at(D, V, n=1, fixed=None):
     nf, m, d = D.shape
     q = d + 1
     r2 = (D ** 2).sum(-1)
-    W = weights(r2, n) * V
+    W = weights(r2, n, floor=True) * V
     moving = np.ones_like(W) if fixed is None else (fixed == 0)
     W = np.where(moving, W, 0.0) + (0.0 if fixed is None else fixed)
     safe = np.where(r2 > 0, r2, 1.0)
-    g = np.where((r2 > 0) & moving, 2.0 * n * W / safe, 0.0)  # (nf, m)
+    # (nf, m); a weight held at the bond floor does not move with the point
+    g = np.where((r2 > BOND_FLOOR) & moving, 2.0 * n * W / safe, 0.0)
     dW = g[..., None] * D
     ddW = g[..., None, None] * (
         2.0 * (n + 1) * D[..., :, None] * D[..., None, :]

@@ -65,7 +65,8 @@ def wte2_gradients(x, volumes, fam, n=1):
     for sl in chunks(nf, m * m * q):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
-        W = weights((D ** 2).sum(-1), n) * geo.V  # master has r2 = 0
+        # the master has r2 = 0
+        W = weights((D ** 2).sum(-1), n, floor=True) * geo.V
         p = taylor2_basis(D)  # (k, i, q)
         Wp = W[..., None] * p
         M = np.swapaxes(Wp, -1, -2) @ p  # (k, q, q)

@@ -42,7 +42,8 @@ def wte1_gradients(x, volumes, fam, n=1):
     for sl in chunks(nf, m * m):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
-        W = weights((D ** 2).sum(-1), n) * geo.V  # master has r2 = 0
+        # the master has r2 = 0
+        W = weights((D ** 2).sum(-1), n, floor=True) * geo.V
         WD = W[..., None] * D
         M = np.swapaxes(WD, -1, -2) @ D
         Minv, singular = inverse_spd(M)
@@ -67,7 +68,7 @@ def mte1_gradients(x, volumes, fam, n=1):
         P = geo.D0
         D = P[:, None, :, :] - P[:, :, None, :]  # D[k,j,i] = X^i - X^j
         pair = geo.mask[:, :, None] & geo.mask[:, None, :] & ~eye_m
-        W = np.where(pair, weights((D ** 2).sum(-1), n)
+        W = np.where(pair, weights((D ** 2).sum(-1), n, floor=True)
                      * geo.V[:, None, :], 0.0)
         WD = W[..., None] * D
         M = np.swapaxes(WD, -1, -2) @ D
