@@ -344,3 +344,35 @@ def test_near_coincident_particles_patch_test(seed, kwargs):
     r = linear_patch_test(_near_coincident(seed), lambda x: x[0] == 1.0,
                           **kwargs)
     assert r["max_error"] <= 1e-10
+
+
+@pytest.mark.parametrize("shift", [1e3, 1e6])
+def test_translation_does_not_matter(shift):
+    """A quadrilateral mesh far from the origin: scikit-fem's facet
+    mapping failed ("Newton iteration didn't converge") at 1e3; facet
+    integrals now run in local coordinates (Particles.facet_origin)."""
+    from skfem_pg.analysis.verification import linear_patch_test
+    rng = np.random.default_rng(0)
+    m = fem.MeshQuad.init_tensor(np.linspace(0, 1, 9), np.linspace(0, 1, 9))
+    inner = ((m.p > 0) & (m.p < 1)).all(axis=0)
+    p = m.p + 0.2 / 8 * rng.uniform(-1, 1, m.p.shape) * inner
+    right = (lambda s: lambda x: np.abs(x[0] - (1.0 + s)) < 1e-6)
+    r0 = linear_patch_test(fem.MeshQuad(p, m.t), right(0.0))
+    r = linear_patch_test(fem.MeshQuad(p + shift, m.t), right(shift))
+    assert r0["max_error"] < 1e-12
+    # what the input's own round-off allows: |X| eps / h
+    assert r["max_error"] < 1e-10 * max(1.0, shift * 1e-4)
+    # a traction callable sees global positions
+    mesh = fem.MeshQuad(p + shift, m.t)
+    basis = pg.FamilyBasis(mesh, dim=2)
+    f = pg.traction(basis, mesh.facets_satisfying(right(shift)),
+                    lambda x: np.stack([x[1] - shift, 0 * x[1]]))
+    assert f[0::2].sum() == pytest.approx(0.5, rel=1e-9)
+
+
+def test_a_patch_test_without_dirichlet_conditions_raises():
+    """All facets Neumann: linear_patch_test returned max error 4.6e16."""
+    from skfem_pg.analysis.verification import linear_patch_test
+    m = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
+    with pytest.raises(SingularSystemError):
+        linear_patch_test(m, m.boundary_facets())

@@ -78,15 +78,19 @@ def traction(basis, facets, t):
     """
     fb = _facet_basis(basis, facets, "traction")
     vector = basis.ncomp is not None
+    # the facet basis is local (Particles.facet_origin); t sees global x
+    origin = basis.particles.facet_origin.reshape(-1, 1, 1)
     if callable(t):
-        tq = call_user(t, fb.global_coordinates(), "the traction t(x)")
+        tq = call_user(t, np.asarray(fb.global_coordinates()) + origin,
+                       "the traction t(x)")
         warn_if_zero(tq, "the traction t(x)")
     else:
         t = _constant(t, basis, "traction t")
 
     @fem.LinearForm
     def load(v, w):
-        tv = call_user(t, w.x, "the traction t(x)") if callable(t) else t
+        tv = (call_user(t, np.asarray(w.x) + origin, "the traction t(x)")
+              if callable(t) else t)
         if vector:
             tv = np.asarray(tv, dtype=float)
             if tv.ndim == 1:

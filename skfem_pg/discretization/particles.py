@@ -178,6 +178,7 @@ class Particles:
         self.elements = elements
         self._area_vectors = None
         self._surface_area_vectors = None
+        self._facet_mesh = None
         self._validate(allow_inactive=elements is not None)
 
     # -- construction ------------------------------------------------------
@@ -384,6 +385,7 @@ class Particles:
         if self.kind != "vertices":
             raise NotImplementedError("area moments need vertex particles")
         x0 = np.zeros(self.dim) if origin is None else np.asarray(origin)
+        x0 = x0 - self.facet_origin  # the facet basis is local
         fb = self._facet_basis(facets)
         out = np.zeros((self.dim, self.dim, fb.N))
         for c in range(self.dim):
@@ -403,8 +405,9 @@ class Particles:
             facets = self.mesh.facets_around(elements)
         else:
             facets = self.mesh.normalize_facets(facets)
-        fb = fem.FacetBasis(self.mesh, e1, facets=facets, intorder=3)
-        xq = np.asarray(fb.global_coordinates()).reshape(self.dim, -1).T
+        fb = fem.FacetBasis(self.facet_mesh(), e1, facets=facets, intorder=3)
+        xq = (np.asarray(fb.global_coordinates()).reshape(self.dim, -1).T
+              + self.facet_origin)
         ndg = (np.asarray(fb.normals) * fb.dx[None]).reshape(self.dim, -1)
         k = min(3 * self.dim, self.n)
         _, nb = cKDTree(self.x.T).query(xq, k=k)
@@ -422,6 +425,28 @@ class Particles:
                                  .ravel(), minlength=self.n)
         return out
 
+    @property
+    def facet_origin(self):
+        """The corner of the mesh's bounding box, shape ``(dim,)``: facet
+        integrals (area vectors, area moments, tractions) are computed on
+        the mesh translated by ``-facet_origin`` — their values do not
+        depend on where the body sits, but scikit-fem's quadrilateral and
+        hexahedral facet mappings (an inverse-mapping Newton iteration
+        with an absolute tolerance of 1e-12) fail on a mesh 1e3 away from
+        the origin.  Facet points ``w.x`` of these integrals are local:
+        add ``facet_origin`` for global positions."""
+        self._need_mesh("facet integrals")
+        return self.mesh.p.min(axis=1)
+
+    def facet_mesh(self):
+        """The mesh translated by ``-facet_origin`` (the mesh itself if
+        that is zero); same elements, facets and facet numbers."""
+        if self._facet_mesh is None:
+            origin = self.facet_origin
+            self._facet_mesh = (self.mesh if not origin.any()
+                                else self.mesh.translated(-origin))
+        return self._facet_mesh
+
     def _facet_basis(self, facets=None, vector=False):
         e1, e0 = linear_elements(self.mesh)
         elem = e1 if self.kind == "vertices" else e0
@@ -429,7 +454,8 @@ class Particles:
             elem = fem.ElementVector(elem)
         facets = (self.boundary_facets() if facets is None
                   else self.mesh.normalize_facets(facets))
-        return fem.FacetBasis(self.mesh, elem, facets=facets, intorder=3)
+        return fem.FacetBasis(self.facet_mesh(), elem, facets=facets,
+                              intorder=3)
 
     def _need_mesh(self, what):
         if self.mesh is None:
