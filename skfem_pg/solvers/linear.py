@@ -476,6 +476,20 @@ class AMGSolver:
         return direct(A, b, self.ordering)
 
 
+def require_stiffness(A, doflocs, components=None):
+    """Raise :class:`~skfem_pg.errors.SingularSystemError` naming the
+    rigid-body modes :func:`free_rigid_body_modes` finds free.  A residual
+    check cannot: a singular system with self-equilibrated loads is
+    consistent, and a direct solver returns one of its solutions."""
+    free = free_rigid_body_modes(A, doflocs, components)
+    if free:
+        raise SingularSystemError(
+            "the system ({} unknowns) has no stiffness against {}: add "
+            "Dirichlet conditions (or springs) that hold {}".format(
+                A.shape[0], ", ".join(free),
+                "it" if len(free) == 1 else "them"))
+
+
 def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                   symmetric=True, candidates=0, components=None,
                   direct_nnz_limit=None):
@@ -515,13 +529,7 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
 
     def solve(A, b, **kwargs):
         if doflocs is not None and A.shape[0] == doflocs.shape[1]:
-            free = free_rigid_body_modes(A, doflocs, components)
-            if free:
-                raise SingularSystemError(
-                    "the system ({} unknowns) has no stiffness against "
-                    "{}: add Dirichlet conditions (or springs) that hold "
-                    "{}".format(A.shape[0], ", ".join(free),
-                                "it" if len(free) == 1 else "them"))
+            require_stiffness(A, doflocs, components)
         k = kind
         if k == "auto":
             small = A.shape[0] <= direct_limit and (
