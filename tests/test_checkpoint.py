@@ -9,7 +9,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.formulations import model_for
-from skfem_pg.materials import J2Plasticity, LinearElastic, NeoHookeIsoVol
+from skfem_pg.materials import J2Plasticity, NeoHookeIsoVol
 from skfem_pg.solvers import (central_difference, checkpoint, lumped_mass,
                               newmark, newton)
 

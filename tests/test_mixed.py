@@ -3,7 +3,6 @@ per family), IUnlP0 (incompressible, per-family pressure as a global
 unknown), U2P1C and Unl+P1C (nodal p, Theta; the bubble condensed) and the
 FE counterparts Q1P0 / H1P0 on the same code path: consistent tangents,
 patch tests, free-block spectra, locking."""
-import re
 
 import numpy as np
 import pytest

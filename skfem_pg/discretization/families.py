@@ -149,7 +149,6 @@ def _needs_enlargement(x, fam, min_size):
     """Families with too few members or with non-master members that do not
     span the space affinely."""
     mem, mask = fam.padded()
-    d = x.shape[0]
     small = fam.sizes < min_size
     # centred non-master member positions, scaled per family
     others = mask.copy()
