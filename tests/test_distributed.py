@@ -225,6 +225,35 @@ def test_coupled_fe_pg_patch_test():
     assert cells == len(left)
 
 
+def test_dofs_without_stiffness_are_named():
+    """A PG element subset solved without its FE cells: the vertices outside
+    the subset have no stiffness (was PETSc error 73 from
+    MatZeroRowsColumns, 'missing diagonal entry')."""
+    from skfem_pg.errors import SingularSystemError
+    mesh = square(10, 0.3, seed=7)
+    right = mesh.elements_satisfying(lambda x: x[0] >= 0)
+    part = dist.Partition(mesh, COMM, elements=right)
+    K = pg.assemble(FORM, part.basis(dim=2))
+    D = np.arange(2 * mesh.nvertices)[::7]  # row 0 prescribed, too
+    with pytest.raises(SingularSystemError, match="no stiffness.*particle"):
+        dist.solve(K, part, np.zeros(2 * mesh.nvertices), D=D)
+
+
+def test_ranks_with_different_meshes_are_refused():
+    """Was a CorrectionError about families on the ranks."""
+    mesh = square(6, 0.2, seed=1 + (COMM.rank > 0))
+    if COMM.size == 1:
+        dist.Partition(mesh, COMM)  # one rank: nothing to compare
+        return
+    with pytest.raises(ValueError, match="same mesh: rank 1 differs"):
+        dist.Partition(mesh, COMM)
+    same = square(6, 0.2, seed=1)
+    right = same.elements_satisfying(lambda x: x[0] >= 0)
+    with pytest.raises(ValueError, match="same elements"):
+        dist.Partition(same, COMM, elements=right if COMM.rank == 0
+                       else np.arange(3))
+
+
 def test_unsupported_options_are_refused():
     mesh = square(6)
     part = dist.Partition(mesh, COMM)

@@ -43,6 +43,8 @@ instead of rank 0's 0.15 s and 1.1 s (4700–5000 GMRES iterations over
 its 14 solves), so it is the choice only where rank 0's memory is the
 limit.
 """
+import hashlib
+
 import numpy as np
 import scipy.sparse as sp
 import skfem as fem
@@ -58,6 +60,26 @@ from .vc import vc_correction
 #: cell rings around the owned particles from which their families are
 #: built: one for the family, three for from_mesh's enlargement
 RINGS = 4
+
+
+def _require_same(comm, what, *arrays):
+    """Raise naming the ranks whose ``arrays`` differ from rank 0's (every
+    rank must hold the same mesh: a rank with another one would build
+    families that do not fit the others')."""
+    h = hashlib.sha256()
+    for a in arrays:
+        a = np.ascontiguousarray(a)
+        h.update(repr((a.dtype.str, a.shape)).encode())
+        h.update(a.tobytes())
+    digests = comm.allgather(h.hexdigest())
+    other = [r for r, d in enumerate(digests) if d != digests[0]]
+    if other:
+        raise ValueError(
+            "every rank must hold the same {}: rank{} {} differ{} from rank "
+            "0's (build it the same way on every rank, or broadcast it)"
+            .format(what, "s" if len(other) > 1 else "",
+                    ", ".join(map(str, other)),
+                    "" if len(other) > 1 else "s"))
 
 
 def _vertex_graph(mesh):
@@ -142,6 +164,10 @@ class Partition:
                  fe_elements=None):
         self.comm = as_mpi(comm)
         self.rank, self.size = self.comm.rank, self.comm.size
+        _require_same(self.comm, "mesh", mesh.p, mesh.t)
+        if elements is not None:
+            _require_same(self.comm, "elements",
+                          np.asarray(mesh.normalize_elements(elements)))
         self.mesh = mesh
         self.particles = Particles.from_mesh(mesh, elements=elements)
         n = self.particles.n

@@ -13,7 +13,7 @@ reads together with the rigid-body near-null space.
 import numpy as np
 import scipy.sparse as sp
 
-from .comm import petsc
+from .comm import mpi, petsc
 
 #: GAMG's drop tolerance unless the options set one
 GAMG_THRESHOLD = 0.05
@@ -53,7 +53,14 @@ def matrix(A, part):
     """
     A = sp.coo_matrix(A)
     g = part.l2g()
-    return global_matrix(g[A.row], g[A.col], A.data, part, part.ncomp)
+    # an explicit (zero) diagonal in every owned row: PETSc's
+    # MatZeroRowsColumns needs it, and a dof without stiffness is then
+    # named by check_rigid_body_modes instead of failing there (error 73)
+    own = g[:part.n_owned_dofs]  # the owned dofs come first (basis)
+    return global_matrix(np.concatenate([g[A.row], own]),
+                         np.concatenate([g[A.col], own]),
+                         np.concatenate([A.data, np.zeros(len(own))]),
+                         part, part.ncomp)
 
 
 def global_matrix(rows, cols, data, part, ncomp):
@@ -296,15 +303,32 @@ TRUE_RESIDUAL_LIMIT = 1e-4
 
 def check_rigid_body_modes(A, part, tol=1e-9):
     """Raise :class:`~skfem_pg.errors.SingularSystemError` if ``A``
-    (Dirichlet rows and columns lifted) leaves rigid-body modes without
-    stiffness (``|A r| <= tol max|diag A| |r|``), saying how many."""
+    (Dirichlet rows and columns lifted) has dofs without stiffness (a zero
+    diagonal: named by particle and position, e.g. the vertices outside a
+    PG element subset when the FE cells were not assembled) or leaves
+    rigid-body modes without stiffness (``|A r| <= tol max|diag A| |r|``),
+    saying how many."""
     from ..errors import SingularSystemError
+    diag = A.getDiagonal()
+    d = diag.getArray()
+    scale = part.comm.allreduce(float(np.abs(d).max(initial=0.0)),
+                                op=mpi().MAX)
+    diag.destroy()
+    bad = part.owned_serial_dofs()[np.abs(d) <= tol * scale]
+    bad = np.concatenate(part.comm.allgather(bad))
+    if len(bad):
+        p = np.unique(bad // part.ncomp)
+        x = part.particles.x[:, p[0]]
+        raise SingularSystemError(
+            "{} dofs of the distributed system have no stiffness (zero "
+            "diagonal), first particle {} at ({}){}: assemble the FE cells "
+            "outside the PG elements (Partition.fe_assemble) or prescribe "
+            "those dofs".format(
+                len(bad), p[0], ", ".join("{:.4g}".format(c) for c in x),
+                "" if len(p) == 1 else " ({} particles)".format(len(p))))
     ns = rigid_body_modes(part)
     if ns is None:
         return
-    diag = A.getDiagonal()
-    scale = max(abs(diag.max()[1]), abs(diag.min()[1]))
-    diag.destroy()
     y = A.createVecLeft()
     free = 0
     vecs = ns.getVecs()
