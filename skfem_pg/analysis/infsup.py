@@ -29,6 +29,7 @@ import skfem as fem
 from skfem.helpers import ddot, div, grad
 
 from ..discretization.assembly import assemble
+from ..formulations import IncompressibleP0, MeanDilatation, NodalPressure
 
 
 @fem.BilinearForm
@@ -123,8 +124,6 @@ def infsup_mixed(model, free, **kw):
       :math:`\sum_j w_{kj} (X^j - X_c^k)\cdot\ldots`, (6.15)).
 
     ``free`` are the free displacement dofs (scikit-fem numbering)."""
-    from ..formulations import (IncompressibleP0, MeanDilatation,
-                                NodalPressure)
     basis = model.basis
     S = assemble(grad_grad, basis)
     if isinstance(model, (MeanDilatation, IncompressibleP0)):

@@ -59,6 +59,7 @@ from .shape.least_squares import (mls1_master_gradients,
                                    wls2_master_gradients)
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
+from ..naming import name_of, parse
 
 METHODS = ("PBG", "PPG1", "PPG2")
 #: test derivatives of PPG at the masters
@@ -470,7 +471,6 @@ class FamilyBasis(AbstractBasis):
         """A basis from a thesis name (Table 7.1), e.g.
         ``FamilyBasis.from_name(p, "VCBCPBG V5 Unl", dim=2)``; see
         :mod:`skfem_pg.naming`."""
-        from ..naming import parse
         kw, notes = parse(name)
         if (isinstance(particles, Particles) and particles.mesh is None
                 and kw.get("families") == "mesh"):
@@ -484,7 +484,6 @@ class FamilyBasis(AbstractBasis):
     @property
     def name(self):
         """Thesis name, e.g. ``"VCBCPBG V5 Unl"``."""
-        from ..naming import name_of
         return name_of(self)
 
     # ------------------------------------------------------------------

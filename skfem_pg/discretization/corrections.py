@@ -40,6 +40,9 @@ import scipy.sparse.linalg as spl
 
 from . import vc_boundary
 from .vc_boundary import BOUNDARY_VARIANTS
+from ..errors import CorrectionError, describe_particle
+from .shape import mls1_master_values
+from .shape.least_squares import wls2_master_hessians, wls2_master_values
 
 
 def bond_directions(x, fam):
@@ -641,7 +644,6 @@ def check_correction(G, x, fam, report, tolerance=1e-8, what="VC"):
     accepts any residual with a warning (for studies of inexact
     corrections).
     """
-    from ..errors import CorrectionError, describe_particle
     if isinstance(G, (list, tuple)):  # per size group, fam the subsets
         Gl, fl = G, fam
     else:
@@ -710,8 +712,6 @@ def correction_functions(variant, x, volumes, fam, n=1):
     * V4, VC2: :math:`N^{kki}_{WLS2} - \delta_{ki}` (keep quadratic
       consistency, for U2).
     """
-    from .shape import mls1_master_values
-    from .shape.least_squares import wls2_master_hessians, wls2_master_values
     mem, mask = fam.padded()
     if variant == "V1":
         phi = mask.astype(float)

@@ -30,6 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 from ..errors import FamilyError, ParticleError, describe_particle
+from .layout import SizeGroups
+from .particles import Particles
 
 
 class Families:
@@ -108,7 +110,6 @@ class Families:
         :class:`~skfem_pg.discretization.layout.SizeGroups` of the families
         (cached)."""
         if self._groups is None:
-            from .layout import SizeGroups
             self._groups = SizeGroups(self)
         return self._groups
 
@@ -199,7 +200,6 @@ def _complete(x, A, masters, min_size, max_rings=3):
 
 
 def _mesh_of(obj):
-    from .particles import Particles
     if isinstance(obj, Particles):
         return obj.mesh, obj.kind, obj.elements, obj.x
     return obj, "vertices", None, obj.p
@@ -373,5 +373,5 @@ def build(rule, particles):
     return f(particles)
 
 
-__all__ = ["Families", "NEAREST", "RULES", "build", "from_mesh", "horizon", "nearest",
-           "check_supports"]
+__all__ = ["Families", "NEAREST", "RULES", "build", "from_mesh", "horizon",
+           "nearest", "check_supports"]

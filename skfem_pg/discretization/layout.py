@@ -67,6 +67,7 @@ class SizeGroups:
             flat = offsets[fam][:, None] + np.arange(m)
             self.groups.append(Group(fam, m, flat, families.members[flat]))
         self.n_families = len(families)
+        self._families_type = type(families)  # no import of families.py
         self.n_particles = families.n_particles
         self.n_points = int(offsets[-1])
         self.m_max = int(sizes.max())
@@ -83,10 +84,9 @@ class SizeGroups:
         :class:`~skfem_pg.discretization.families.Families` of their own (no
         padding: the
         batched kernels run on it unchanged)."""
-        from .families import Families
         nf, m = group.members.shape
-        return Families(np.arange(nf + 1) * m, group.members.ravel(),
-                        self.n_particles)
+        return self._families_type(np.arange(nf + 1) * m,
+                                   group.members.ravel(), self.n_particles)
 
     def is_flat(self, shape):
         """Whether trailing quadrature axes ``shape`` are the flat layout

@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 import skfem as fem
 
 from ..errors import ParticleError, UnsupportedMeshError, describe_particle
+from .shape import mls1_values
 
 # nodal (P1/Q1) and constant (P0) element of each supported linear mesh
 _LINEAR_ELEMENTS = {
@@ -398,7 +399,6 @@ class Particles:
         return out
 
     def _mls_area_vectors(self, facets=None):
-        from .shape import mls1_values
         e1, _ = linear_elements(self.mesh)
         elements = self.elements
         if facets is None:

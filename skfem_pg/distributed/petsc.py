@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .comm import mpi, petsc
+from ..errors import SingularSystemError
 
 #: GAMG's drop tolerance unless the options set one
 GAMG_THRESHOLD = 0.05
@@ -308,7 +309,6 @@ def check_rigid_body_modes(A, part, tol=1e-9):
     PG element subset when the FE cells were not assembled) or leaves
     rigid-body modes without stiffness (``|A r| <= tol max|diag A| |r|``),
     saying how many."""
-    from ..errors import SingularSystemError
     diag = A.getDiagonal()
     d = diag.getArray()
     scale = part.comm.allreduce(float(np.abs(d).max(initial=0.0)),

@@ -22,7 +22,7 @@ import numpy as np
 from . import petsc as pt
 from .comm import mpi
 from ..dofs import as_dofs
-from ..scenes.scene import Result
+from ..solvers.result import Result
 from ..solvers.static import ConvergenceError, verdict
 
 
@@ -250,7 +250,7 @@ def _newton_step(model, part, U0, lam, F, rows, prescribed, tol, maxiter,
 
 @dataclass
 class DistributedResult(Result):
-    """A scene's :class:`~skfem_pg.scenes.scene.Result` from a distributed
+    """A scene's :class:`~skfem_pg.solvers.result.Result` from a distributed
     solve: the same fields, in the serial numbering on every rank;
     ``model`` is the rank's part, and :meth:`residual` (so
     :meth:`reaction`) gathers the internal forces of all ranks."""

@@ -33,6 +33,7 @@ from .incompressible import IncompressibleP0
 from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 from .stabilized import U1SIG, U1SUnl
+from ..naming import FE_NAMES, SHAPES
 
 #: built formulation tokens beyond the displacement ones
 MIXED = {"UnlP0": MeanDilatation, "IUnlP0": IncompressibleP0}
@@ -50,7 +51,6 @@ def model_for(formulation, basis, material, tangent="consistent"):
     family basis whose shape functions are not the token's
     (:data:`~skfem_pg.naming.SHAPES`: ``U2``, ``U2P1``, ``U2P1C`` need
     WTE2), raises ``ValueError`` naming it."""
-    from ..naming import FE_NAMES, SHAPES
     if formulation not in SHAPES and formulation not in FE_NAMES:
         raise ValueError(
             "unknown formulation {!r}: Table 7.1 tokens are {}; FE methods "

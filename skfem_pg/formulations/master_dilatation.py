@@ -39,6 +39,7 @@ from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .dilatation import _d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, material_tangent
+from .incompressible import incompressible_shear_modulus
 
 
 class MasterDilatation(Hyperelastic):
@@ -200,7 +201,6 @@ class MasterIncompressible(MasterDilatation):
     def of(cls, basis, material):
         """From :meth:`NeoHookeIsoVol.incompressible(mu)
         <skfem_pg.materials.NeoHookeIsoVol.incompressible>`."""
-        from .incompressible import incompressible_shear_modulus
         return cls(basis, incompressible_shear_modulus(material)
                    ).with_material(material)
 

@@ -6,6 +6,8 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 """
 import os
 
+from .. import threads
+
 
 def output_dir(path=None, create=True):
     """Where demos and benchmarks write: ``path`` (their ``--out``), else
@@ -44,7 +46,6 @@ def update_results(path, section, text):
     the path written, or ``None`` (with a printed note) if it cannot be
     written — e.g. an installed copy without the source tree."""
     import datetime
-    from .. import threads
     begin, end = ("<!-- begin {} -->".format(section),
                   "<!-- end {} -->".format(section))
     stamp = "*{}; {}.*".format(datetime.date.today().isoformat(),

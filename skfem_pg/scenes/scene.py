@@ -35,7 +35,6 @@ the reaction forces (:meth:`Result.reaction`).
 """
 import hashlib
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 import skfem as fem
@@ -46,7 +45,11 @@ from ..discretization.loads import (call_user, traction as pg_traction,
 from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
 from ..formulations.updated_lagrange import UpdatedLagrange
+from ..naming import fe_method, formulation_of, frame_of, parse
 from ..solvers import newton
+from ..solvers.result import Result
+from .. import distributed
+from ..distributed.solve import DistributedResult
 
 #: method -> (mesh class needed, scalar element)
 FE_METHODS = {
@@ -69,52 +72,6 @@ FE_METHODS = {
 #: took 4x the points); T2/O2: scikit-fem's defaults
 INTORDER = {"T1": 1, "O1": 1, "Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2,
             "Q2": 4, "H2": 4}
-
-
-@dataclass
-class Result:
-    """A scene solution.
-
-    ``u``: the displacements in scikit-fem numbering of ``basis`` (for
-    every formulation); ``fields``: the formulation's extra fields by name
-    (e.g. ``p`` and ``Theta`` per element or family for Q1P0 / UnlP0;
-    ``ep``, the accumulated plastic strain, per family or cell for a
-    plastic material);
-    ``x``: all unknowns of ``model`` (``u`` first); ``f_ext``: the external
-    forces at the end of the load path."""
-    method: str
-    u: np.ndarray
-    basis: object
-    probes: dict
-    times: dict
-    history: list = field(default_factory=list)
-    fields: dict = field(default_factory=dict)
-    model: object = None
-    x: np.ndarray = None
-    f_ext: np.ndarray = None
-
-    @property
-    def total_time(self):
-        return sum(self.times.values())
-
-    def residual(self):
-        """:math:`f_{int}(u) - f_{ext}` on the displacement dofs: zero
-        (to the solver's tolerance) where the displacements are free, the
-        reaction forces where they are prescribed."""
-        r = self.model.internal_force(self.model.state(self.x))
-        return r[:len(self.u)] - self.f_ext
-
-    def reaction(self, boundary):
-        """The total reaction force vector ``(d,)`` on the named
-        ``boundary`` (or facets): the sum, per component, of the residual
-        :meth:`residual` over the boundary's dofs (nodal and, for
-        quadratic elements, facet and edge dofs).  Meaningful on a
-        boundary whose displacements are prescribed."""
-        r = self.residual()
-        dofs = self.basis.get_dofs(boundary)
-        d = self.basis.mesh.dim()
-        return np.array([r[dofs.all("u^{}".format(c + 1))].sum()
-                         for c in range(d)])
 
 
 class Scene:
@@ -353,9 +310,6 @@ class Scene:
 
     def _solve_distributed(self, scheme, comm, verbose, tangent, tol,
                            options, basis_kwargs):
-        from ..distributed import Partition, newton as dnewton
-        from ..distributed.solve import DistributedResult
-        from ..naming import frame_of
         method, formulation, basis_kwargs = _scheme(scheme, basis_kwargs)
         if method != "PG":
             raise NotImplementedError(
@@ -368,7 +322,7 @@ class Scene:
                 "formulations (Unl, U1) in the total Lagrangian frame"
                 .format(scheme))
         t0 = time.perf_counter()
-        part = Partition(self.mesh, comm)
+        part = distributed.Partition(self.mesh, comm)
         basis = part.basis(dim=self.dim, **basis_kwargs)
         model = model_for(formulation, basis, self.material, tangent)
         # the collocation mesh's FE basis: serial numbering, FE-consistent
@@ -379,9 +333,9 @@ class Scene:
                  for n, t in self.tractions.items()), np.zeros(serial.N))
         D, u_D = self._dirichlet(serial)
         t_pre = time.perf_counter() - t0
-        u, hist = dnewton(model, part, f, D=D, u_D=u_D, steps=self.steps,
-                          tol=tol, options=None if options == "auto"
-                          else options, verbose=verbose)
+        u, hist = distributed.newton(
+            model, part, f, D=D, u_D=u_D, steps=self.steps, tol=tol,
+            options=None if options == "auto" else options, verbose=verbose)
         times = {"preprocess": t_pre,
                  "assemble": sum(h["t_assemble"] for h in hist),
                  "solve": sum(h["t_linear"] for h in hist)}
@@ -397,7 +351,6 @@ class Scene:
         name in the updated Lagrangian frame (``"... Unl UL"``) gives an
         :class:`~skfem_pg.formulations.UpdatedLagrange` model, rebuilt
         every ``params["ul_every"]`` converged steps (default 1)."""
-        from ..naming import frame_of
         t0 = time.perf_counter()
         method, formulation, basis_kwargs = _scheme(scheme, basis_kwargs)
         if method == "PG":
@@ -457,7 +410,6 @@ def _scheme(scheme, basis_kwargs):
     ``method`` is the FE method of :data:`FE_METHODS` or ``"PG"`` (for
     ``"PG"`` and thesis names, whose basis options are merged under the
     given ``basis_kwargs``)."""
-    from ..naming import fe_method, formulation_of, parse
     method = fe_method(scheme) or scheme
     if method in FE_METHODS or method == "PG":
         return method, "Unl", basis_kwargs

@@ -23,6 +23,7 @@ import time
 import zipfile
 
 import numpy as np
+from ..naming import name_of
 
 #: bump when the stored content changes meaning
 FORMAT = 2
@@ -61,7 +62,6 @@ def fingerprint(model):
     material = getattr(model, "material", None)
     material = getattr(material, "material", material)  # a History's law
     if hasattr(basis, "layout"):
-        from ..naming import name_of
         try:
             kind = name_of(basis)
         except (KeyError, ValueError):

@@ -48,6 +48,7 @@ from .checkpoint import Every, load as load_checkpoint
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
                        MAX_STEPS, check_run, commit, history_of,
                        history_text, stored_energy, time_functions)
+from ..discretization.particles import inverted_cells
 
 
 #: steps before the energy check starts: an impulsive start (a velocity
@@ -351,7 +352,6 @@ def inversion_note(model, u):
     p = getattr(model.basis, "particles", None)
     if p is None or p.kind != "vertices" or p.mesh is None:
         return ""
-    from ..discretization.particles import inverted_cells
     bad = inverted_cells(p, u[:model.n_u])
     if not bad.size:
         return "; no cell of the collocation mesh is inverted"

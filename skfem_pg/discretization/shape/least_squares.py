@@ -18,6 +18,7 @@ import numpy as np
 
 from .common import (BOND_FLOOR, FamilyGeometry, chunks, weights,
                      inverse_spd, raise_singular)
+from .quadratic import quadratic_terms, taylor2_basis
 
 
 def _basis(D, order):
@@ -25,7 +26,6 @@ def _basis(D, order):
     one = np.ones(D.shape[:-1] + (1,))
     if order == 1:
         return np.concatenate([one, D], axis=-1)
-    from .quadratic import taylor2_basis
     return np.concatenate([one, taylor2_basis(D)], axis=-1)
 
 
@@ -187,7 +187,6 @@ def wls2_master_hessians(x, volumes, fam, n=1):
     correction function V2 (5.61).  They annihilate constant and linear
     fields: :math:`\sum_i \partial^2 N^{ki} = 0`,
     :math:`\sum_i \Delta X^{ki}\otimes\partial^2 N^{ki} = 0`."""
-    from .quadratic import quadratic_terms
     c, h = master_fits(x, volumes, fam, n, 2)
     d = x.shape[0]
     H = np.zeros(c.shape[:2] + (d, d))

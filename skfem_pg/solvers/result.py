@@ -1,0 +1,55 @@
+"""The result of a load-stepped solve: displacements, the formulation's
+fields, probes, timings, and the reactions of prescribed boundaries.
+
+It lives below :mod:`skfem_pg.scenes` (which returns it) and
+:mod:`skfem_pg.distributed` (whose ``DistributedResult`` extends it).
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class Result:
+    """A scene solution.
+
+    ``u``: the displacements in scikit-fem numbering of ``basis`` (for
+    every formulation); ``fields``: the formulation's extra fields by name
+    (e.g. ``p`` and ``Theta`` per element or family for Q1P0 / UnlP0;
+    ``ep``, the accumulated plastic strain, per family or cell for a
+    plastic material);
+    ``x``: all unknowns of ``model`` (``u`` first); ``f_ext``: the external
+    forces at the end of the load path."""
+    method: str
+    u: np.ndarray
+    basis: object
+    probes: dict
+    times: dict
+    history: list = field(default_factory=list)
+    fields: dict = field(default_factory=dict)
+    model: object = None
+    x: np.ndarray = None
+    f_ext: np.ndarray = None
+
+    @property
+    def total_time(self):
+        return sum(self.times.values())
+
+    def residual(self):
+        """:math:`f_{int}(u) - f_{ext}` on the displacement dofs: zero
+        (to the solver's tolerance) where the displacements are free, the
+        reaction forces where they are prescribed."""
+        r = self.model.internal_force(self.model.state(self.x))
+        return r[:len(self.u)] - self.f_ext
+
+    def reaction(self, boundary):
+        """The total reaction force vector ``(d,)`` on the named
+        ``boundary`` (or facets): the sum, per component, of the residual
+        :meth:`residual` over the boundary's dofs (nodal and, for
+        quadratic elements, facet and edge dofs).  Meaningful on a
+        boundary whose displacements are prescribed."""
+        r = self.residual()
+        dofs = self.basis.get_dofs(boundary)
+        d = self.basis.mesh.dim()
+        return np.array([r[dofs.all("u^{}".format(c + 1))].sum()
+                         for c in range(d)])
