@@ -21,7 +21,7 @@ the geometric nonlinearity:
    2 agrees to 0.07 %), for O1 and PG on the same gmsh tetrahedra, with
    wall time.
 
-Node sets: gmsh tetrahedra (``skfem_pg/scenes/meshes/cook3d.geo``, ``--sizes``)
+Node sets: gmsh tetrahedra (``meshes/cook3d.geo``, ``--sizes``)
 and regular hexahedral grids split into tetrahedra (``--grids``), distorted by
 ±0.3h.  Writes ``out/bending_3d.png``.
 

@@ -3,7 +3,7 @@ O1 and O2 on the same irregular tetrahedral node sets and H1P0 on
 distorted hexahedral grids.
 
 The 2-D outline (0,0), (48,44), (48,60), (0,44) extruded by a thickness of
-10 in z (``skfem_pg/scenes/meshes/cook3d.geo``); clamped at x = 0; a dead area
+10 in z (``meshes/cook3d.geo``); clamped at x = 0; a dead area
 load q = 4 in +z on the face x = 48 (thesis 7.1).  The thesis' figure with
 thickness and material is not in the text: we use thickness 10 and the iso/vol
 neo-Hooke (2.43) with lambda = 100, mu = 40 (the 2-D Cook's constants), so

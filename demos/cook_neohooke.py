@@ -9,7 +9,7 @@ clearly nonlinear.  Quantity: vertical displacement of the top-right corner
 (48, 60), compared with a T2 overkill solution (cached in
 ~/.cache/skfem_pg, or $SKFEM_PG_CACHE).
 
-Methods on each node set (skfem_pg/scenes/meshes/cook.geo, element sizes
+Methods on each node set (meshes/cook.geo, element sizes
 --sizes):
   T1                       scikit-fem P1 triangles, consistent tangent
   PBG Unl                  MTE1 + bond correction, no VC

@@ -2,9 +2,10 @@
 gmsh geometries.
 
 gmsh is used through its Python API; ``.geo`` sources ship as package data
-in ``skfem_pg/scenes/meshes/`` (:func:`geo_path`).
+in the repository's ``meshes/`` (:func:`geo_path`).
 """
 import dataclasses
+import importlib.util
 import os
 import tempfile
 
@@ -408,11 +409,23 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
     return renumber(mesh) if reorder and order == 1 else mesh
 
 
+def _meshes_dir():
+    """The directory of the ``.geo`` sources: the installed data package
+    ``skfem_pg.meshes`` (wheel, editable install), else the repository's
+    top-level ``meshes/`` next to the package (a source checkout on
+    ``PYTHONPATH``)."""
+    spec = importlib.util.find_spec("skfem_pg.meshes")
+    if spec is not None and spec.origin:
+        return os.path.dirname(os.path.abspath(spec.origin))
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                        os.pardir, os.pardir, "meshes")
+
+
 def geo_path(name):
-    """Path of a ``.geo`` file shipped with the package
-    (``skfem_pg/scenes/meshes/``: cook.geo, cook3d.geo, cube.geo,
-    square.geo, beam3d.geo, plate_hole3d.geo)."""
-    here = os.path.join(os.path.dirname(os.path.abspath(__file__)), "meshes")
+    """Path of a ``.geo`` file shipped with the package (the repository's
+    ``meshes/``, installed as ``skfem_pg.meshes``: cook.geo, cook3d.geo,
+    cube.geo, square.geo, beam3d.geo, plate_hole3d.geo)."""
+    here = os.path.normpath(_meshes_dir())
     fn = os.path.join(here, name)
     if not os.path.isfile(fn):
         raise FileNotFoundError("no mesh source {!r} in {} (available: {})"
