@@ -126,7 +126,7 @@ def test_scene_solves_by_thesis_and_fe_names():
         s.solve("VCPBG")
 
 
-#: every formulation name the thesis text uses (thesis-remaining.md A8)
+#: every formulation name the thesis text uses (thesis Table 7.1 and its text)
 THESIS_NAMES = [
     "PPG Unl", "PBG Unl", "BCPBG Unl", "VCBCPBG Unl", "VCPBG Unl",
     "VCPPG Unl", "VCPPG V1sn Unl", "VCPPG V2sn Unl", "VCPPG V3p Unl",

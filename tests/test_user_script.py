@@ -1,4 +1,5 @@
-"""The user script of the design card (architecture.md) works."""
+"""The user script the package was designed around (mesh → particles →
+families → basis → forms → solve, in scikit-fem style) works."""
 import numpy as np
 import skfem as fem
 from skfem.helpers import ddot, sym_grad, trace, eye

@@ -1,8 +1,8 @@
 r"""FamilyBasis — particle families as scikit-fem elements.
 
 A family :math:`H^k` is an element whose quadrature points are its members
-``j`` and whose basis functions are its members ``i`` (formulas.md
-section 2).  With
+``j`` and whose basis functions are its members ``i`` ((4.25),
+(4.30)).  With
 
 * quadrature weights (PBG, (4.25), (4.30))
   :math:`w_{kj} = V^k V^j / V_H^k`, :math:`V_H^k = \sum_{j\in H^k} V^j`,

@@ -1,8 +1,8 @@
 r"""Particle families :math:`H^k` — the "elements" of a PG method.
 
-A family is an ordered list of particle indices, **master first**
-(formulas.md section 1).  :class:`Families` stores them ragged (CSR-like
-``offsets``/``members``) and hands out a padded ``(nf, m)`` view with a mask
+A family is an ordered list of particle indices, **master first**.
+:class:`Families` stores them ragged (CSR-like ``offsets``/``members``)
+and hands out a padded ``(nf, m)`` view with a mask
 for the batched shape-function kernels and the unpadded size groups of
 :mod:`skfem_pg.discretization.layout` for the hot paths.
 

@@ -1,7 +1,7 @@
 r"""Particles collocated from scikit-fem meshes.
 
 A particle ``p`` carries a reference position :math:`X^p` and a volume
-:math:`V^p > 0` (formulas.md section 1).  Two collocations are offered:
+:math:`V^p > 0`.  Two collocations are offered:
 
 * ``kind="vertices"`` (default): positions are the mesh vertices and the
   volumes are lumped, :math:`V^p = \int_\Omega N_p \,d\Omega` (row sum of the

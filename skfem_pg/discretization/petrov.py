@@ -2,7 +2,7 @@ r"""Peridynamic Petrov–Galerkin (PPG) test bases, thesis (4.21)–(4.22).
 
 PPG evaluates the test-shape derivatives once per family, at the master:
 :math:`G_t^{kki}` (here the WTE1 derivative at the master, which MTE1
-shares).  Written over bonds (formulas.md section 2),
+shares).  Written over bonds ((4.21)),
 
 .. math::
 
@@ -44,7 +44,7 @@ from .families import Families
 
 def pairwise(fam):
     """Families completed to pairwise ones: ``j`` joins :math:`H^k`
-    whenever ``k`` is in :math:`H^j` (formulas.md section 1 (c))."""
+    whenever ``k`` is in :math:`H^j`."""
     A = fam.adjacency().astype(float)
     masters = fam.masters
     if len(masters) != fam.n_particles:

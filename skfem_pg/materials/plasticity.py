@@ -19,7 +19,7 @@ plastic strain :math:`\bar e_p`, since :math:`|n_F| = \sqrt{3/2}`).
   \tau_{dev}/\sigma_{vM}`, :math:`\dot C_p^{-1} = -2\dot\lambda F^{-1} n F
   C_p^{-1}`, :math:`\dot\alpha = \dot\lambda`.
 * Exponential integration (4.41) *with the minus sign that (2.52)
-  requires* (the printed (4.41) lost it; ``thesis-remaining.md`` A1):
+  requires* (the printed (4.41) lost it):
   :math:`C_p^{-1} = F^{-1}\exp(-2\Delta\alpha\, n) F C_{p,n}^{-1}`, i.e.
   :math:`b_e = \exp(-2\Delta\alpha\, n)\, b_e^{tr}` with the trial
   :math:`b_e^{tr} = F C_{p,n}^{-1} F^T`.  As :math:`n` is an isotropic

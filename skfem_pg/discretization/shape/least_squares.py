@@ -1,7 +1,7 @@
 r"""Weighted / moving least-squares shape functions.
 
 MLS1 *values at the master*, with the master's own weight excluded
-(:math:`\omega^{kk} = 0`; formulas.md section 3):
+(:math:`\omega^{kk} = 0`; weights (5.41)):
 
 .. math::
 

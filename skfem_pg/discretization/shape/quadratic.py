@@ -8,7 +8,7 @@ the derivatives reproduce exactly):
     p(\Delta X) = (\Delta X_a;\ \Delta X_a\Delta X_b,\ a\le b)
     \quad\text{(2-D: 5 terms, 3-D: 9)},
 
-moment matrix and derivatives (formulas.md section 3)
+moment matrix and derivatives (weights (5.41))
 
 .. math::
 
