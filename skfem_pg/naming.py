@@ -45,7 +45,8 @@ Every formulation of Table 7.1 parses: :func:`parse` gives the options of
 its *displacement* basis (MTE1 for ``UnlP0``, WTE2 for ``U2P1``, ...) and
 :func:`formulation_of` the formulation token, which
 :func:`skfem_pg.formulations.by_name.model_for` turns into a model (and
-which raises ``NotImplementedError`` for the formulations not built yet).
+which raises ``NotImplementedError`` for a combination that is not
+built, naming it).
 """
 import re
 
@@ -109,7 +110,9 @@ def parse(name):
     """``(kwargs, notes)`` for the displacement
     :class:`~skfem_pg.FamilyBasis` of a thesis name, with Table 7.1's
     defaults; raises ``ValueError`` naming what is not understood and
-    ``NotImplementedError`` for options that are not built (UL)."""
+    ``NotImplementedError`` for combinations that are not built (UL for
+    other formulations than :data:`UL_FORMULATIONS` or other methods than
+    PBG; see the checks below)."""
     if fe_method(name) is not None:
         raise ValueError("{!r} is an FE comparator, not a family basis: "
                          "use Scene.solve({!r})".format(name, name))

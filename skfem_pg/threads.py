@@ -3,12 +3,13 @@
 The kernels of this package (shape functions, corrections, batched local
 matrices, material laws) multiply and invert millions of 3×3 … 81×81
 matrices.  A multi-threaded BLAS (OpenBLAS, MKL) wakes its thread pool for
-each of these tiny products; on 2 cores that oversubscription made the test
-suite 1.4–5× slower than with one thread and flipped timing rankings
-between identical runs.  So every kernel entry point runs with **one BLAS
-thread** by default, through threadpoolctl (which changes the pool of the
-BLAS already loaded by NumPy at run time; environment variables only act
-before NumPy is imported).  Code outside the kernels — the user's own, and
+each of these tiny products; on 2 cores that oversubscription slowed the
+test suite several times and flipped timing rankings between identical
+runs (benchmarks/README.md, "Measurements behind the defaults").  So
+every kernel entry point runs with **one BLAS thread** by default,
+through threadpoolctl (which changes the pool of the BLAS already loaded
+by NumPy at run time; environment variables only act before NumPy is
+imported).  Code outside the kernels — the user's own, and
 the sparse direct and AMG solvers — keeps the BLAS default.
 
 ``SKFEM_PG_BLAS_THREADS`` (environment) or :func:`set_kernel_threads`

@@ -206,12 +206,10 @@ class _AMGSolve:
     nonsymmetric variant, energy-minimising prolongators, coarsest level of
     up to 5000 unknowns by SuperLU) for the pinned scalar VC matrix: its
     cost grows about linearly with the particles, where the sparse LU's
-    fill does not.  On gmsh tetrahedra (benchmarks/README.md), 7
-    right-hand sides: 20.8k particles 274 iterations; 51.9k 1.3 s setup +
-    10.6 s (48 iterations each) against 24 s with the default SA
-    settings and 89 s for COLAMD's LU.  ``solve`` takes one or several
-    right-hand-side columns; a column that does not reach ``tol`` in
-    ``maxiter`` iterations raises ``RuntimeError``."""
+    fill does not (benchmarks/README.md, "Measurements behind the
+    defaults").  ``solve`` takes one or several right-hand-side columns;
+    a column that does not reach ``tol`` in ``maxiter`` iterations raises
+    ``RuntimeError``."""
 
     def __init__(self, A, tol=1e-12, maxiter=400):
         import pyamg
@@ -253,7 +251,8 @@ class _AMGSolve:
 
 
 #: particles above which ``vc_solver="auto"`` takes AMG-GMRES in 3-D (the
-#: LU is faster below: 1.2 s at 7.4k gmsh particles)
+#: LU is faster below; benchmarks/README.md, "Measurements behind the
+#: defaults")
 AMG_VC_LIMIT_3D = 15000
 
 
@@ -320,9 +319,9 @@ def _solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
         except RuntimeError:
             sol = None  # the LU below
     if sol is None:
-        if d == 3:  # COLAMD alone: 6.4x faster than RCM + MMD at 7.4k
-            lu = _PermutedLU(Ac, np.arange(Ac.shape[0]), "COLAMD")  # gmsh
-        else:  # 2-D: RCM + MMD_AT_PLUS_A (0.34 s vs COLAMD's 0.49 s, 40k)
+        if d == 3:  # COLAMD alone (faster in 3-D, benchmarks/README.md)
+            lu = _PermutedLU(Ac, np.arange(Ac.shape[0]), "COLAMD")
+        else:  # 2-D: RCM + MMD_AT_PLUS_A
             lu = _PermutedLU(Ac, reverse_cuthill_mckee(
                 Ac, symmetric_mode=False))
         sol = lu.solve(rhs)

@@ -5,8 +5,8 @@
 form functions, same ``assemble`` signature); their ``assemble`` runs
 :func:`skfem_pg.assemble` on family bases and scikit-fem cell bases, so a
 script that swaps ``Basis`` for ``FamilyBasis`` changes one import line and
-keeps fast-path speed (scikit-fem's ``docs/examples/ex43.py``: 107 s through
-the generic loop, 2.8 s here; ``tests/test_forms.py``).  On a
+keeps fast-path speed (``tests/test_forms.py``; benchmarks/README.md,
+"Measurements behind the defaults").  On a
 Petrov–Galerkin basis they test with ``basis.test``.  Forms the fast path
 cannot probe (``u.hess``, ...) and other bases (facet, composite, mixed)
 take scikit-fem's generic path.

@@ -32,16 +32,14 @@ with the serial code (:func:`_solve_pinned_lu`, the same pivoting LU and
 minimum-norm projection), then broadcasts :math:`\alpha`.  So the
 distributed VC basis *is* the serial one up to the order of floating-point
 sums (tests: 1e-12).  The price is a scalar :math:`n \times n` system on
-rank 0, :math:`d^3` times cheaper than the block system: the whole VC
-step took 1.1 s at 12k particles and 2.6 s at 26k on 2 ranks (3-D Cook
-hexahedra; AMG above 15k particles, ``vc_solver="amg"``).  With
+rank 0, :math:`d^3` times cheaper than the block system (AMG above 15k
+particles, ``vc_solver="amg"``).  With
 ``vc_solver="petsc"`` no rank holds more than its own families: the same
 pinned system is solved on all ranks by GMRES
 (:mod:`~skfem_pg.distributed.vc`; equal to the serial basis to 1e-12 in
-the tests) — at 4375 and 12,321 particles on 2 ranks 5.8 s and 20.7 s
-instead of rank 0's 0.15 s and 1.1 s (4700–5000 GMRES iterations over
-its 14 solves), so it is the choice only where rank 0's memory is the
-limit.
+the tests) — many times slower than rank 0's solve
+(benchmarks/README.md, "Measurements behind the defaults"), so it is
+the choice only where rank 0's memory is the limit.
 """
 import hashlib
 

@@ -47,10 +47,9 @@ def matrix(A, part):
 
     The rows of halo dofs go to their owners (one ``alltoall``); each
     rank sums its rows in CSR with global columns and hands them to
-    ``MatCreateMPIAIJWithArrays`` — exact preallocation, no ``MatSetValues``.
-    (scikit-fem's ``MATIS`` route, ``MatConvert`` to ``MATMPIAIJ``, took
-    5.4 s for the 2028 dofs of a 676-particle 3-D family basis, 760k
-    non-zeros, in PETSc 3.18; this takes 0.05 s.)
+    ``MatCreateMPIAIJWithArrays`` — exact preallocation, no ``MatSetValues``
+    (scikit-fem's ``MATIS`` route with ``MatConvert`` was about 100 times
+    slower).
     """
     A = sp.coo_matrix(A)
     g = part.l2g()

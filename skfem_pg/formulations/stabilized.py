@@ -390,7 +390,7 @@ class U1SIG(_MasterModel):
         (\tilde A^k : \partial_E H^k)_{AB}`, :math:`\partial_E H^k_{CD} =
         \sum_l u^l_C\, \partial^2_{DE} N^{kkl}` — what an explicit step
         needs, where :math:`\tilde A^k` changes with every committed step
-        and assembling the matrix would cost 20x the force."""
+        and assembling the matrix would cost far more than the force."""
         A, H, M2 = self._frozen_tangent(), self.hessians, self.M2
         d = A.shape[1]
         U = np.asarray(u, dtype=float).reshape(-1, d)

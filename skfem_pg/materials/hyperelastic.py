@@ -32,8 +32,8 @@ def det(F):
 
 def inverse_and_det(F):
     """Inverse and determinant of ``(d, d, ...)`` arrays; ``d = 2, 3`` by
-    cofactors (contiguous, no batched LAPACK call: 5x faster on 60k
-    points), other ``d`` by ``numpy.linalg``."""
+    cofactors (contiguous, no batched LAPACK call), other ``d`` by
+    ``numpy.linalg``."""
     d = F.shape[0]
     if d == 2:
         J = det(F)

@@ -321,9 +321,8 @@ def renumber(mesh):
     subdomains are carried over).
 
     gmsh numbers vertices with bandwidth of the order of their count; in
-    this order the sparse kernels stay in cache: on 51.9k gmsh tetrahedron
-    vertices PG assembly (pattern and values) takes 8.0 s instead of
-    15.2 s, families 0.76 s instead of 1.22 s, and FE profits alike.
+    this order the sparse kernels stay in cache (PG assembly about twice
+    as fast, benchmarks/README.md, "Measurements behind the defaults").
     Quadratic meshes are returned unchanged."""
     from scipy.sparse.csgraph import reverse_cuthill_mckee
     if mesh.doflocs.shape[1] != mesh.nvertices:

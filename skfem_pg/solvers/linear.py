@@ -153,23 +153,17 @@ def direct(A, b, ordering="auto", **kwargs):
     PARDISO (its own nested-dissection ordering, MKL's threads); a
     symmetric matrix in its symmetric indefinite mode on the upper
     triangle (LDL^T), a non-symmetric one by LU.  ``ordering="rcm+mmd"``: reverse
-    Cuthill–McKee permutation, then SuperLU's ``MMD_AT_PLUS_A``; measured
-    on 14k–80k dof 2-D elasticity systems (gmsh triangles, distorted
-    grids; T1/Q1 and PG) the fastest of scipy's options or within 1.3x of
-    it, while each SuperLU ordering alone is up to 27x slower on one of
-    them.  A symmetric matrix is factorized with diagonal pivots
+    Cuthill–McKee permutation, then SuperLU's ``MMD_AT_PLUS_A`` (on 2-D
+    elasticity systems the fastest of scipy's options or close to it).  A
+    symmetric matrix is factorized with diagonal pivots
     (SuperLU's ``SymmetricMode``), a non-symmetric one with threshold
     pivoting that keeps the diagonal (:data:`DIAG_PIVOT`); either is
     checked by its residual and refactorized with partial pivoting if that
-    is above :data:`PIVOT_CHECK` (condensed mixed tangents, 3.4k unknowns:
-    UnlP0 0.08 s against 0.9 s, Unl+P1C 0.5 s against 3.3 s, PPG UnlP0
-    0.1 s against 0.95 s; benchmarks/mixed_newton.py).  A saddle point
-    (zero diagonal entries: the pressure rows of IUnlP0, U2P1C) goes to
-    ``COLAMD`` instead (IUnlP0, 5k unknowns: 0.25 s against 9.6 s).
-    ``ordering="colamd"``: SuperLU's ``COLAMD``; on 3-D Cook
-    tetrahedra (3.7k / 9.7k dof) 2.1x / 4.4x faster than ``rcm+mmd`` for
-    O1 and 0.8x / 2.7x for PG.  Usable as ``fem.solve(A, b,
-    solver=direct)``.
+    is above :data:`PIVOT_CHECK`.  A saddle point (zero diagonal entries:
+    the pressure rows of IUnlP0, U2P1C) goes to ``COLAMD`` instead.
+    ``ordering="colamd"``: SuperLU's ``COLAMD`` (the faster one on 3-D
+    tetrahedra).  Measured: benchmarks/README.md, "Measurements behind
+    the defaults".  Usable as ``fem.solve(A, b, solver=direct)``.
 
     Every answer is checked (:func:`check_solution`): a singular system
     raises :class:`~skfem_pg.errors.SingularSystemError` instead of
@@ -218,8 +212,8 @@ def _direct(A, b, ordering):
 
 
 #: one ``pypardiso.PyPardisoSolver`` per matrix type, kept: creating one
-#: looks up MKL's library (about 0.12 s), more than factorizing 3k
-#: unknowns; its factors are freed after every solve
+#: looks up MKL's library, which costs more than factorizing a small
+#: system; its factors are freed after every solve
 _PARDISO_SOLVERS = {}
 
 
@@ -253,7 +247,7 @@ def _pardiso(A, b):
 PIVOT_CHECK = 1e-11
 #: SuperLU's ``diag_pivot_thresh`` for non-symmetric matrices: the diagonal
 #: is kept while it is at least this fraction of the column's largest entry
-#: (PPG UnlP0, 3.4k unknowns: 0.1 s against 0.95 s with partial pivoting)
+#: (about ten times faster than partial pivoting on condensed PPG tangents)
 DIAG_PIVOT = 0.01
 
 
@@ -263,27 +257,18 @@ def _symmetric(A, tol=1e-12):
 
 
 #: ``"auto"``: the largest direct solve (unknowns) per spatial dimension
-#: with the default install's SuperLU.  3-D Cook tetrahedra, one solve of
-#: the linear system (``benchmarks/solvers_3d.py``): SuperLU (COLAMD)
-#: against AMG-CG, PG (kNN) 0.17 / 0.32 s at 3.7k unknowns and 2.4 / 1.1 s
-#: at 11k, O1 0.05 / 0.18 s and 0.57 / 0.30 s: the crossover is near 6k
-#: for both.  2-D: above 60k.
+#: with the default install's SuperLU: the measured crossover with AMG-CG
+#: (``benchmarks/solvers_3d.py``; benchmarks/README.md, "Measurements behind
+#: the defaults").
 DIRECT_LIMIT = {2: 60_000, 3: 6_000}
 #: the same with MKL PARDISO (``[pardiso]`` extra; its symmetric LDL^T),
 #: which also stops at :data:`DIRECT_NNZ_LIMIT_PARDISO` non-zeros.
 DIRECT_LIMIT_PARDISO = {2: 60_000, 3: 150_000}
 #: ``"auto"`` with PARDISO: the largest direct solve in non-zeros per
 #: spatial dimension.  Its cost follows the matrix graph, not the unknowns
-#: alone: 3-D Cook tetrahedra, one solve against AMG-CG
-#: (``benchmarks/solvers_3d.py``), PG (150 non-zeros per row) 2.6 / 2.1 s
-#: at 25k unknowns (3.6M non-zeros), 4.3 / 5.0 s at 40k (5.9M), 10.2 /
-#: 9.3 s at 74k (11M); O1 (42 per row) 2.1 / 2.9 s at 74k (3.1M), 5.6 /
-#: 6.2 s at 133k (5.7M).  In Newton (``benchmarks/newton_3d.py``) a kept
-#: AMG hierarchy costs PG on tetrahedra 14.5 s per iteration at 74k (11M),
-#: about a factorization's; PG with the thesis recipe on a 40^3/4 hex grid
-#: (54k unknowns, 17.0M non-zeros) 45 s of solve per iteration with AMG
-#: (249 CG iterations) against 8.3 s direct.  Hence 24M (on tetrahedra
-#: the unknowns' limit comes first).
+#: alone (``benchmarks/solvers_3d.py``, ``benchmarks/newton_3d.py``;
+#: benchmarks/README.md, "Measurements behind the defaults"); on
+#: tetrahedra the unknowns' limit comes first.
 DIRECT_NNZ_LIMIT_PARDISO = {3: 24_000_000}
 
 
@@ -330,20 +315,15 @@ class AMGSolver:
       Gauss-Seidel sweeps, join the rigid-body modes as near-null-space
       candidates: PG tangents have many soft modes (Jacobi-scaled
       condition number 8e4 against O1's 2e3 on a 1.2k-node cube), which
-      the rigid-body modes alone leave to CG.  Cube, linear elasticity,
-      one solve, CG iterations / setup: 6.9k free nodes 51 / 4.9 s with
-      6 candidates, 30 / 9.4 s with 12, 21 / 12.0 s with 18 (O1 14 /
-      1.0 s); 19.7k free nodes 108 / 34 s with 6, 55 / 27 s with 12,
-      29-34 / 45 s with 18 (O1 16 / 2.5 s).  Without the Gauss-Seidel
-      smoothing, or with Jacobi or Chebyshev instead, 18 candidates need
-      48-60 iterations on the 6.9k set (benchmarks/README.md).
+      the rigid-body modes alone leave to CG.  More candidates cut the CG
+      iterations and raise the setup (benchmarks/README.md,
+      "Measurements behind the defaults").
     * ``graph``: a sparse node adjacency (free nodes) whose standard
       aggregates replace the tangent's on the first level, e.g. the
       families' one-ring graph for PG, whose tangent couples two rings and
-      aggregates too coarsely (operator complexity 1.03).  On a 20.8k-node
-      cube (linear elasticity, one solve): 125 CG iterations against 213
-      without candidates, 58 against 108 with 6; not the default yet
-      (setup 16 s / 60 s against 10 s / 34 s, benchmarks/README.md).
+      aggregates too coarsely (operator complexity 1.03).  Fewer CG
+      iterations at a costlier setup; not the default
+      (benchmarks/README.md, "Measurements behind the defaults").
     * Fallback chain: CG fails on indefinite tangents (past a limit point,
       or PG at an overshooting Newton iterate); then MINRES with the same
       (positive) preconditioner; above ``direct_limit`` unknowns GMRES with

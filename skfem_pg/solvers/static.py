@@ -37,10 +37,8 @@ class ConvergenceError(RuntimeError):
 #: extra smoothed random near-null-space candidates of the AMG hierarchy
 #: for family bases (:class:`AMGSolver`).  12 is the measured compromise:
 #: 18 needs the fewest iterations but the longest setup, which Newton's
-#: rebuilds (after load steps and fallbacks) pay again; 3-D Cook, 4,038
-#: nodes, PG seconds per Newton iteration with 6 / 12 / 18: 6.63 / 6.50 /
-#: 7.57 (Krylov its 48 / 37 / 34); one linear solve, 59k unknowns, setup +
-#: solve about 61 / 41 / 54 s (benchmarks/README.md)
+#: rebuilds (after load steps and fallbacks) pay again (benchmarks/README.md,
+#: "Measurements behind the defaults")
 PG_CANDIDATES = 12
 
 
