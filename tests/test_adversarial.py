@@ -376,3 +376,17 @@ def test_a_patch_test_without_dirichlet_conditions_raises():
     m = fem.MeshQuad.init_tensor(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
     with pytest.raises(SingularSystemError):
         linear_patch_test(m, m.boundary_facets())
+
+
+def test_a_held_mode_of_a_nearly_incompressible_body_is_not_called_free():
+    """Near incompressibility only the shear modulus at the clamp resists a
+    translation along the clamped edge: |A r| / (max|diag A| |r|) = 4e-11
+    here (lambda / mu = 2e9, Cook, Q1P0 16 x 16); the old bound 1e-9 called
+    it free and refused the solve (the cook_incompressible overkill)."""
+    g = 0.375
+    sc = Scene("held-mode", pg.meshing.cook_membrane(16),
+               mat.NeoHookeIsoVol(g, 7.5e8 + 2.0 * g / 3.0),
+               clamped=["left"], tractions={"right": [0.0, 1e-6]},
+               probes={"v": (48.0, 52.0)})
+    r = sc.solve("Q1P0", solver="direct")
+    assert 0.0 < r.probes["v"][1] < 1e-3

@@ -15,6 +15,7 @@ import scipy.sparse as sp
 
 from .comm import mpi, petsc
 from ..errors import SingularSystemError
+from ..solvers.linear import RIGID_MODE_TOL
 
 #: GAMG's drop tolerance unless the options set one
 GAMG_THRESHOLD = 0.05
@@ -301,13 +302,15 @@ def release_options(ksp):
 TRUE_RESIDUAL_LIMIT = 1e-4
 
 
-def check_rigid_body_modes(A, part, tol=1e-9):
+def check_rigid_body_modes(A, part, tol=None):
     """Raise :class:`~skfem_pg.errors.SingularSystemError` if ``A``
     (Dirichlet rows and columns lifted) has dofs without stiffness (a zero
     diagonal: named by particle and position, e.g. the vertices outside a
     PG element subset when the FE cells were not assembled) or leaves
     rigid-body modes without stiffness (``|A r| <= tol max|diag A| |r|``),
-    saying how many."""
+    saying how many (``tol``: :data:`~skfem_pg.solvers.linear.RIGID_MODE_TOL`,
+    also the zero-diagonal bound)."""
+    tol = RIGID_MODE_TOL if tol is None else tol
     diag = A.getDiagonal()
     d = diag.getArray()
     scale = part.comm.allreduce(float(np.abs(d).max(initial=0.0)),
