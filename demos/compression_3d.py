@@ -142,4 +142,6 @@ if __name__ == "__main__":
     ap.add_argument("--adaptive", action="store_true",
                     help="cut failed load steps instead of stopping")
     a = ap.parse_args()
+    if a.quick:
+        a.sizes, a.steps = [3], 2
     main(a.sizes, a.tets, a.steps, a.adaptive, a.results)

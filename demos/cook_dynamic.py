@@ -171,4 +171,6 @@ if __name__ == "__main__":
                     help="load amplitude [kN/mm] (default 10: the thesis' "
                     "10000 read as N/mm)")
     a = ap.parse_args()
+    if a.quick:
+        a.n, a.steps = 4, 20
     main(a.n, a.steps, a.variants, a.results, a.out, a.q0)

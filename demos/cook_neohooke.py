@@ -144,4 +144,6 @@ if __name__ == "__main__":
     ap.add_argument("--ref-refine", type=int, default=1)
     a = ap.parse_args()
     OUT = output_dir(a.out)
+    if a.quick:
+        a.sizes, a.ref_size, a.ref_refine = [8.0], 8.0, 0
     main(a.sizes, a.ref_size, a.ref_refine, a.results)

@@ -106,4 +106,4 @@ if __name__ == "__main__":
     ap.add_argument("--distortion", type=float, default=0.0)
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.nx, a.ny, a.distortion)
+    main(*((6, 3) if a.quick else (a.nx, a.ny)), a.distortion)

@@ -36,10 +36,11 @@ THESIS = {"PBG Unl": (8.563e-3, 1.284e-1),
           "VCPPG V3sn Unl": (6.489e-17, 9.974e-16)}
 
 
-def node_sets():
-    square = fem.MeshQuad.init_tensor(*[np.linspace(-1, 1, 37)] * 2)
+def node_sets(quick=False):
+    square = fem.MeshQuad.init_tensor(
+        *[np.linspace(-1, 1, 9 if quick else 37)] * 2)
     gmsh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"),
-                               size=0.0575)
+                               size=0.25 if quick else 0.0575)
     return {
         "regular quads": square,
         "distorted quads": pg.meshing.distort(square, 0.3, seed=1),
@@ -47,9 +48,9 @@ def node_sets():
     }
 
 
-def main():
+def main(quick=False):
     rows = []
-    for set_name, mesh in node_sets().items():
+    for set_name, mesh in node_sets(quick).items():
         for name in VARIANTS:
             kw, _ = parse(name)
             r = linear_patch_test(mesh, lambda x: np.isclose(x[1], 1.0), **kw)
@@ -93,5 +94,6 @@ def plot(rows, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    OUT = output_dir(ap.parse_args().out)
-    main()
+    a = ap.parse_args()
+    OUT = output_dir(a.out)
+    main(a.quick)

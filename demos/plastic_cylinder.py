@@ -63,6 +63,8 @@ def main():
     ap.add_argument("--n", type=int, default=6,
                     help="elements across the wall (default 6)")
     args = ap.parse_args()
+    if args.quick:
+        args.n = 2
     out = output_dir(args.out)
     scene = Scene("plastic cylinder", pg.meshing.annulus(args.n, A, B), MATERIAL, prescribed={
         "inner": lambda x, t: t * U_A * x / np.hypot(x[0], x[1]),

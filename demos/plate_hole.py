@@ -218,4 +218,4 @@ if __name__ == "__main__":
                     help="cells along each half of the hole's arc")
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.n, a.results)
+    main(4 if a.quick else a.n, a.results)

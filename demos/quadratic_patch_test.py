@@ -95,4 +95,4 @@ if __name__ == "__main__":
     ap.add_argument("--n", type=int, default=12)
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.n)
+    main(6 if a.quick else a.n)

@@ -24,13 +24,18 @@ def output_dir(path=None, create=True):
 
 def demo_parser(doc, results=False):
     """The ``argparse`` parser of a demo or benchmark: its description is
-    the first line of ``doc``; ``--out`` (:func:`output_dir`) and, with
+    the first line of ``doc``; ``--out`` (:func:`output_dir`), ``--quick``
+    (the demo's seconds-long variant, run by the tests) and, with
     ``results``, ``--results`` (a markdown page whose section of this
     script :func:`update_results` rewrites)."""
     import argparse
     ap = argparse.ArgumentParser(description=doc.split("\n")[0])
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
+    ap.add_argument("--quick", action="store_true",
+                    help="a run of seconds on small node sets (what "
+                    "tests/test_demos.py runs); the numbers it prints are "
+                    "not the demo's claims")
     if results:
         ap.add_argument("--results", help="markdown page whose section of "
                         "this script is rewritten (e.g. "

@@ -1,0 +1,125 @@
+"""Every demo with a ``--quick`` mode runs that way and prints the number it
+exists to show (as scikit-fem's ``tests/test_examples.py`` does for its
+examples).  Marked ``demo``: the README's test command leaves them out,
+``.ci/run`` runs them (``python -m pytest -m demo``).
+
+Each check reads the demo's printed table; the quick node sets are small, so
+the checks are the demo's qualitative claim (a patch test passed, no
+spurious mode, a consistent tangent), not its converged numbers."""
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+pytestmark = pytest.mark.demo
+
+DEMOS = os.path.join(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__))), "demos")
+
+
+def _rows(text, label):
+    """The numbers on the lines that contain ``label`` followed by
+    whitespace (after the label)."""
+    out = []
+    for line in text.splitlines():
+        i = line.find(label)
+        if i >= 0 and line[i + len(label):i + len(label) + 1].isspace():
+            out.append([float(v) for v in re.findall(
+                r"[-+]?\d+\.?\d*(?:e[-+]?\d+)?", line[i + len(label):])])
+    return out
+
+
+def _patch(out):
+    rows = _rows(out, "VCBCPBG V5m Unl")  # node set, eps_L2, eps_H1, max
+    assert len(rows) == 3
+    assert max(r[0] for r in rows) <= 1e-10
+
+
+def _quadratic_patch(out):
+    (row,) = _rows(out, "VC2PBG V4m U2")
+    assert row[0] <= 1e-10
+
+
+def _eigenmodes(out):
+    (row,) = _rows(out, "VC PBG Unl")  # zero, spurious, soft, lambda_4
+    assert row[:3] == [3, 0, 0]
+
+
+def _plastic_cylinder(out):
+    (row,) = _rows(out, "FEM Q1P0")  # p / p_lim first
+    assert abs(row[0] - 1.0) <= 0.02
+
+
+def _stability_patch(out):
+    vc = [line for line in out.splitlines()
+          if line.strip().startswith("VC PBG Unl") and "soft" in line]
+    u1 = [line for line in out.splitlines()
+          if line.strip().startswith("U1 (WTE1)") and "soft" in line]
+    soft = re.compile(r"soft \(< [\d.]+\)\s+(\d+)")
+    assert int(soft.search(vc[0]).group(1)) == 0
+    assert int(soft.search(u1[0]).group(1)) > 0
+
+
+def _punch(out):
+    left = {m.group(1): float(m.group(2)) for m in re.finditer(
+        r"^\s+(Q1|VC PBG Unl)\s+remaining thickness\s+([\d.]+)%", out,
+        re.M)}
+    assert left["VC PBG Unl"] < left["Q1"]
+
+
+def _plate_hole(out):
+    ref = float(re.search(r"reference \(Q2 overkill\)\s+([\d.]+)",
+                          out).group(1))
+    (row,) = _rows(out, "PPG Unl + Q1")
+    assert abs(row[0] / ref - 1.0) <= 0.05
+
+
+def _cook_neohooke(out):
+    exact = [r for r in _rows(out, "VC PBG Unl") if len(r) > 3]
+    fd = [r for r in _rows(out, "(FD tangent)") if len(r) > 3]
+    assert exact[0][0] == fd[0][0]  # the same tip displacement
+    assert exact[0][3] == fd[0][3]  # in as many Newton iterations
+
+
+def _compression_3d(out):
+    rows = [line.split("|") for line in out.splitlines()
+            if re.match(r"\|\s*\d+\s*\|\s*(PG|H1)\s*\|", line)]
+    assert {r[2].strip() for r in rows} == {"PG", "H1"}
+    for r in rows:
+        assert r[3].strip() == "done" and r[7].strip() == "0"
+
+
+def _cook_dynamic(out):
+    rows = re.findall(r"^\| (\S+ [TU]L) \| (\w+) \|", out, re.M)
+    assert len(rows) == 8 and all(r[1] == "done" for r in rows)
+
+
+CHECKS = {
+    "patch_test.py": (_patch, "patch_test.png"),
+    "quadratic_patch_test.py": (_quadratic_patch, "quadratic_patch_test.png"),
+    "eigenmodes.py": (_eigenmodes, "eigenmodes.png"),
+    "plastic_cylinder.py": (_plastic_cylinder, "plastic_cylinder.png"),
+    "stability_patch.py": (_stability_patch, "stability_patch.png"),
+    "punch.py": (_punch, "punch.png"),
+    "plate_hole.py": (_plate_hole, "plate_hole.png"),
+    "cook_neohooke.py": (_cook_neohooke, "cook_neohooke.png"),
+    "compression_3d.py": (_compression_3d, None),
+    "cook_dynamic.py": (_cook_dynamic, "cook_dynamic.png"),
+}
+
+
+@pytest.mark.parametrize("demo", sorted(CHECKS))
+def test_demo_quick(demo, tmp_path):
+    check, figure = CHECKS[demo]
+    env = dict(os.environ, SKFEM_PG_CACHE=str(tmp_path / "cache"),
+               MPLBACKEND="Agg")
+    run = subprocess.run(
+        [sys.executable, os.path.join(DEMOS, demo), "--quick", "--out",
+         str(tmp_path / "out")], cwd=tmp_path, env=env, capture_output=True,
+        text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    check(run.stdout)
+    if figure is not None:
+        assert (tmp_path / "out" / figure).stat().st_size > 0
