@@ -5,7 +5,7 @@ Geometry (0,0), (48,44), (48,60), (0,44); E = 1, nu = 1/3, plane stress;
 left edge clamped, total shear load 1 on the right edge.  The quantity is the
 vertical displacement v(48, 52); the literature value is 23.96, our reference
 is a Q2 overkill solution (Richardson-extrapolated from 64x64 and 128x128,
-cached in out/).
+``skfem_pg.scenes.reference.linear_cook``, cached).
 
 Methods on the same nodes (regular and ±0.3h distorted node sets):
   T1, Q1          scikit-fem elements
@@ -18,7 +18,6 @@ out/cook_membrane.png and a VTU of the finest VC PBG Unl solution.
 
     python demos/cook_membrane.py [--max-n 128]
 """
-import json
 import os
 import time
 
@@ -29,6 +28,7 @@ import skfem_pg as pg
 from skfem_pg.scenes.reporting import demo_parser, output_dir
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
+from skfem_pg.scenes.reference import linear_cook
 from skfem_pg.scenes.reporting import plot_error_vs_time
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -49,35 +49,7 @@ PG_METHODS = {
 
 
 def tip_dof(mesh):
-    node = np.nonzero(np.all(np.isclose(mesh.p, POINT[:, None]), axis=0))[0]
-    if len(node) != 1:
-        raise RuntimeError("(48, 52) is not a node; use an even n")
-    return 2 * node[0] + 1
-
-
-def reference():
-    """Q2 overkill v(48, 52), cached."""
-    fn = os.path.join(OUT, "cook_reference.json")
-    if os.path.exists(fn):
-        with open(fn) as fh:
-            return json.load(fh)["v"]
-    vals = []
-    for n in (64, 128):
-        m = pg.meshing.cook_membrane(n)
-        e = fem.ElementVector(fem.ElementQuad2())
-        b = fem.Basis(m, e)
-        fb = fem.FacetBasis(m, e, facets="right")
-        f = fem.LinearForm(lambda v, w: v[1] / 16.0).assemble(fb)
-        u = fem.solve(*fem.condense(FORM.assemble(b), f,
-                                    D=b.get_dofs("left")))
-        vals.append(float((b.probes(POINT[:, None]) @ u)[1]))
-        print("  Q2 overkill {0}x{0}: v = {1:.5f}".format(n, vals[-1]))
-    rate = 2.0  # observed ~1.4 (corner singularity); 2 is conservative
-    v = vals[1] + (vals[1] - vals[0]) / (2 ** rate - 1)
-    os.makedirs(OUT, exist_ok=True)
-    with open(fn, "w") as fh:
-        json.dump({"v": v, "q2": vals}, fh)
-    return v
+    return 2 * pg.meshing.vertex_at(mesh, POINT) + 1
 
 
 def solve_fe(mesh, elem):
@@ -107,8 +79,8 @@ def solve_pg(mesh, kw):
     return u, (t1 - t0, t2 - t1, t3 - t2), b
 
 
-def main(max_n=64):
-    ref = reference()
+def main(max_n=64, ref_sizes=(64, 128)):
+    ref, _ = linear_cook(LAM, MU, ref_sizes)
     print("reference v(48,52) = {:.5f} (Q2 overkill; literature {})"
           .format(ref, LITERATURE))
     ns = [n for n in (4, 8, 16, 32, 64, 128) if n <= max_n]
@@ -175,4 +147,4 @@ if __name__ == "__main__":
                     help="finest elements per side (even; default 64)")
     a = ap.parse_args()
     OUT = output_dir(a.out)
-    main(a.max_n)
+    main(8, (16, 32)) if a.quick else main(a.max_n)

@@ -26,7 +26,7 @@ from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
 
-from cook_membrane import FORM as COOK_FORM, reference, tip_dof
+from skfem_pg.scenes.reference import linear_cook
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 
@@ -65,12 +65,17 @@ def patch_test(kind):
     return out
 
 
-def cook(n=32):
-    ref = reference()
+#: Cook's membrane: E = 1, nu = 1/3, plane stress (as demos/cook_membrane.py)
+COOK_LAM, COOK_MU = lame(1.0, 1.0 / 3.0, plane_stress=True)
+COOK_FORM = linear_elasticity(COOK_LAM, COOK_MU)
+
+
+def cook(n=32, ref_sizes=(64, 128)):
+    ref, _ = linear_cook(COOK_LAM, COOK_MU, ref_sizes)
     mesh = pg.meshing.distort(pg.meshing.cook_membrane(n), 0.3, seed=n)
     mesh = mesh.with_boundaries({"left": lambda x: np.isclose(x[0], 0),
                                  "right": lambda x: np.isclose(x[0], 48)})
-    dof = tip_dof(mesh)
+    dof = 2 * pg.meshing.vertex_at(mesh, (48.0, 52.0)) + 1
     q1 = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
     D = q1.get_dofs("left")
     fb = fem.FacetBasis(mesh, fem.ElementVector(fem.ElementQuad1()),
@@ -87,15 +92,16 @@ def cook(n=32):
     return mesh, res, dof, ref, fe, pgb
 
 
-def main():
+def main(quick=False):
     print("coupled linear patch test, max nodal error (FE x < 0, PG x >= 0):")
     for kind in ("quad", "tri"):
         for label, err in patch_test(kind).items():
             print("  {:4s} FE + {:16s} {:.3e}".format(
                 "Q1" if kind == "quad" else "T1", label, err))
-    mesh, res, dof, ref, fe, pgb = cook()
-    print("\nCook's membrane, irregular 33x33 nodes, reference v(48,52) = "
-          "{:.4f}".format(ref))
+    n = 8 if quick else 32
+    mesh, res, dof, ref, fe, pgb = cook(n, (16, 32) if quick else (64, 128))
+    print("\nCook's membrane, irregular {0}x{0} nodes, reference v(48,52) = "
+          "{1:.4f}".format(n + 1, ref))
     for name, u in res.items():
         print("  {:16s} v = {:.4f}  rel. error {:.2e}".format(
             name, u[dof], abs(u[dof] - ref) / ref))
@@ -136,5 +142,6 @@ def plot(mesh, u, fe, pgb, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    OUT = output_dir(ap.parse_args().out)
-    main()
+    a = ap.parse_args()
+    OUT = output_dir(a.out)
+    main(a.quick)

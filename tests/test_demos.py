@@ -96,7 +96,30 @@ def _cook_dynamic(out):
     assert len(rows) == 8 and all(r[1] == "done" for r in rows)
 
 
+def _cook_membrane(out):
+    ref = float(re.search(r"reference v\(48,52\) = ([\d.]+)", out).group(1))
+    assert abs(ref / 23.96 - 1.0) <= 5e-4  # the literature value
+    err = {m.group(1): float(m.group(2)) for m in re.finditer(
+        r"^regular\s+8\s+81 (T1|VC PBG Unl)\s+[\d.]+\s+([\d.e+-]+)", out,
+        re.M)}
+    assert err["VC PBG Unl"] < err["T1"]
+
+
+def _coupling(out):
+    vc = [float(v) for v in re.findall(r"FE \+ VC PBG Unl\s+([\d.e+-]+)",
+                                       out)]
+    plain = [float(v) for v in re.findall(
+        r"FE \+ PBG Unl \(no VC\)\s+([\d.e+-]+)", out)]
+    assert len(vc) == 2 and max(vc) <= 1e-10  # Q1 and T1 coupled to PG
+    assert min(plain) >= 1e-3  # without VC the union fails the patch test
+    err = dict(re.findall(r"^  (Q1|Q1 \| PG coupled)\s+v = [\d.]+\s+rel\. "
+                          r"error ([\d.e+-]+)", out, re.M))
+    assert float(err["Q1 | PG coupled"]) <= 1.5 * float(err["Q1"])
+
+
 CHECKS = {
+    "cook_membrane.py": (_cook_membrane, "cook_membrane.png"),
+    "coupling.py": (_coupling, "coupling.png"),
     "patch_test.py": (_patch, "patch_test.png"),
     "quadratic_patch_test.py": (_quadratic_patch, "quadratic_patch_test.png"),
     "eigenmodes.py": (_eigenmodes, "eigenmodes.png"),

@@ -85,3 +85,28 @@ def test_prescribed_components_of_quadratic_elements():
     assert np.abs(r.u[D]).max() == 0.0
     Dr = r.basis.get_dofs("right").all("u^1")
     assert np.allclose(r.u[Dr], 0.05)
+
+
+def test_linear_cook_reference_is_cached_and_checked(cache, capsys):
+    from skfem_pg.scenes.reference import linear_cook
+    v, (c, f) = linear_cook(1.0, 0.5, sizes=(4, 8))
+    assert v == pytest.approx(f + (f - c) / 3.0)
+    assert "Q2 overkill" in capsys.readouterr().out
+    assert linear_cook(1.0, 0.5, sizes=(4, 8)) == (v, (c, f))
+    assert capsys.readouterr().out == ""  # from the cache
+    (fn,) = [os.path.join(cache_dir(), n) for n in os.listdir(cache_dir())]
+    size = os.path.getsize(fn)
+    with open(fn, "r+b") as fh:  # a truncated entry: recomputed, named
+        fh.truncate(size // 2)
+    with pytest.warns(UserWarning, match="linear-cook"):
+        assert linear_cook(1.0, 0.5, sizes=(4, 8))[0] == pytest.approx(v)
+    assert linear_cook(1.0, 0.6, sizes=(4, 8))[0] != v  # another key
+
+
+def test_vertex_at_names_a_point_without_vertex():
+    import skfem_pg as pg
+    mesh = pg.meshing.cook_membrane(4)
+    assert np.allclose(mesh.p[:, pg.meshing.vertex_at(mesh, (48, 52))],
+                       (48, 52))
+    with pytest.raises(ValueError, match=r"no vertex at \(48.0, 51.0\)"):
+        pg.meshing.vertex_at(mesh, (48, 51))

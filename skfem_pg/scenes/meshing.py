@@ -62,6 +62,22 @@ def _bilinear_map(xi, eta, corners):
             + xi * eta * c[2][:, None] + (1 - xi) * eta * c[3][:, None])
 
 
+def vertex_at(mesh, point, tol=1e-9):
+    """The index of the vertex of ``mesh`` at ``point`` (within ``tol``
+    times the mesh's extent); ``ValueError`` naming the point and the
+    nearest vertex if there is none."""
+    point = np.asarray(point, dtype=float)
+    dist = np.linalg.norm(mesh.p - point[:, None], axis=0)
+    k = int(np.argmin(dist))
+    extent = np.ptp(mesh.p, axis=1).max()
+    if dist[k] > tol * extent:
+        raise ValueError("no vertex at {}: the nearest, {}, is at {} "
+                         "(distance {:.3g})".format(
+                             tuple(point.tolist()), k,
+                             tuple(mesh.p[:, k].tolist()), dist[k]))
+    return k
+
+
 def cook_membrane(n, kind="quad"):
     """Cook's membrane with ``n`` elements per side.
 
