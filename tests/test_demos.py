@@ -117,7 +117,20 @@ def _coupling(out):
     assert float(err["Q1 | PG coupled"]) <= 1.5 * float(err["Q1"])
 
 
+def _cook_incompressible(out):
+    richardson = float(re.search(r"Richardson ([\d.]+)", out).group(1))
+    assert abs(richardson / 16.4326 - 1.0) <= 1e-3  # the published value
+    err = dict(re.findall(r"^\s+8\s+81 (.+?)\s+v =\s+[\d.]+\s+error "
+                          r"([\d.e+-]+)", out, re.M))
+    for locking in ("Q1", "VCPBG Unl"):
+        assert float(err[locking]) > 0.5
+    for mixed in ("Q1P0", "VCPBG UnlP0", "VCBCPBG V5m Unl+P1C"):
+        assert float(err[mixed]) < 0.1
+
+
 CHECKS = {
+    "cook_incompressible.py": (_cook_incompressible,
+                               "cook_incompressible.png"),
     "cook_membrane.py": (_cook_membrane, "cook_membrane.png"),
     "coupling.py": (_coupling, "coupling.png"),
     "patch_test.py": (_patch, "patch_test.png"),
