@@ -250,5 +250,8 @@ if __name__ == "__main__":
                     "--results table goes to (default cook_3d)")
     args = ap.parse_args()
     OUT = output_dir(args.out)
+    if args.quick:
+        args.sizes, args.hex, args.reference = [3.5], [4], [6]
+        args.methods = ["O1", "VC PBG Unl kNN"]
     main(args.sizes, args.hex, args.results, args.methods, args.section,
          args.reference)

@@ -171,7 +171,9 @@ if __name__ == "__main__":
     ap.add_argument("--full", action="store_true",
                     help="sizes 4 8 12 16, reference 24 x 24 x 12")
     a = ap.parse_args()
-    if a.full:
+    if a.quick:
+        main([4], 6, None, a.out)
+    elif a.full:
         main([4, 8, 12, 16], 24, a.results, a.out)
     else:
         main(a.sizes, 12, a.results, a.out)

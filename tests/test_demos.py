@@ -128,7 +128,23 @@ def _cook_incompressible(out):
         assert float(err[mixed]) < 0.1
 
 
+def _cook_3d(out):
+    ratio = float(re.search(r"nodes: VC PBG Unl kNN ([\d.]+),", out).group(1))
+    assert ratio < 0.75  # kNN's corner error against O1's on 615 nodes
+
+
+def _punch_3d(out):
+    incompressible = out[out.index("nu = 0.49999"):]
+    err = dict(re.findall(r"^\s+4\s+75 (.+?)\s+min u_z = \S+\s+error\s+"
+                          r"([-+\d.]+)%", incompressible, re.M))
+    assert float(err["H1"]) > 90 and float(err["VCBCPBG V5m Unl"]) > 90
+    assert abs(float(err["VCBCPBG V5m Unl+P1C"])) < 5  # no locking
+    assert "VCBCPBG V5m IUnlP0" in err
+
+
 CHECKS = {
+    "cook_3d.py": (_cook_3d, "cook_3d.png"),
+    "punch_3d.py": (_punch_3d, "punch_3d.png"),
     "cook_incompressible.py": (_cook_incompressible,
                                "cook_incompressible.png"),
     "cook_membrane.py": (_cook_membrane, "cook_membrane.png"),
