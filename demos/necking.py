@@ -330,5 +330,8 @@ if __name__ == "__main__":
                     "VCPBG MTE1 ones also with kNN (their default there), "
                     "FEM O1 and O2 for H1P0")
     a = ap.parse_args()
+    if a.quick:  # past the force's peak (0.75 mm), no overkill
+        a.overkill, a.methods, a.elongation = 0, ["FEM H1P0",
+                                                  "VCPBG UnlP0"], 1.0
     main(6 if a.full else a.n, a.overkill, a.methods, a.results, a.out,
          a.verbose, a.elongation, a.full_bar, a.scale, a.tets)

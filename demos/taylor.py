@@ -277,6 +277,8 @@ if __name__ == "__main__":
                     "MTE1 ones also with kNN (their default there), FEM O1 "
                     "for H1/H1P0")
     a = ap.parse_args()
+    if a.quick:
+        a.n, a.methods, a.t_end = 1, ["VCPBG Unl", "FEM H1"], 3.0
     methods = a.methods or (
         [k for k, v in METHODS.items() if v[1]] if a.explicit else
         list(DEFAULT))

@@ -233,4 +233,6 @@ if __name__ == "__main__":
     ap.add_argument("--full", action="store_true",
                     help="the thesis' 16 x 16 x 80 elements (hours)")
     a = ap.parse_args()
+    if a.quick:
+        a.n, a.methods = 2, ["FEM H1", "PBG Unl"]
     main(16 if a.full else a.n, a.methods, a.results, a.out)

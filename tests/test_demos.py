@@ -142,7 +142,40 @@ def _punch_3d(out):
     assert "VCBCPBG V5m IUnlP0" in err
 
 
+def _table_rows(out):
+    """The rows of the markdown table a demo prints, as lists of cells."""
+    return {cells[1].strip(): [c.strip() for c in cells[2:-1]]
+            for cells in (line.split("|") for line in out.splitlines()
+                          if line.startswith("| ") and "---" not in line)}
+
+
+def _necking(out):
+    rows = _table_rows(out)
+    peak = {k: float(rows[k][4].split()[0]) for k in ("FEM H1P0",
+                                                      "VCPBG UnlP0")}
+    assert rows["VCPBG UnlP0"][-1] == "done"
+    assert abs(peak["VCPBG UnlP0"] / peak["FEM H1P0"] - 1.0) <= 0.03
+
+
+def _torsion(out):
+    rows = _table_rows(out)
+    assert int(rows["PBG Unl (VCPBG Unl)"][0]) > int(rows["FEM H1 (H1)"][0])
+
+
+def _taylor(out):
+    rows = _table_rows(out)
+    pg_, fe = rows["VCPBG Unl"], rows["FEM H1"]
+    assert pg_[-1] == fe[-1] == "done"
+    for col, tol in ((0, 0.01), (1, 0.05)):  # length, mushroom radius
+        a, b = (float(r[col].split()[0]) for r in (pg_, fe))
+        assert abs(a / b - 1.0) <= tol
+    assert float(pg_[6]) <= 1e-3  # energy error
+
+
 CHECKS = {
+    "necking.py": (_necking, "necking.png"),
+    "torsion.py": (_torsion, "torsion.png"),
+    "taylor.py": (_taylor, "taylor.png"),
     "cook_3d.py": (_cook_3d, "cook_3d.png"),
     "punch_3d.py": (_punch_3d, "punch_3d.png"),
     "cook_incompressible.py": (_cook_incompressible,
