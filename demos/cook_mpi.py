@@ -69,6 +69,8 @@ def main():
                     "sparse direct) on the same nodes")
     ap.add_argument("--json", default=None)
     args = ap.parse_args()
+    if args.quick:
+        args.n, args.nz, args.steps = 4, 1, 1
     comm = dist.as_mpi()
     rank, size = comm.rank, comm.size
     t_all = time.perf_counter()
