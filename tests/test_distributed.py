@@ -27,6 +27,8 @@ pytest.importorskip("pymetis")
 from mpi4py import MPI  # noqa: E402
 from skfem_pg import distributed as dist  # noqa: E402
 
+pytestmark = pytest.mark.mpi  # pytest -m mpi: these alone
+
 COMM = MPI.COMM_WORLD
 LAM, MU = lame(100.0, 0.3)
 FORM = linear_elasticity(LAM, MU)
