@@ -3,7 +3,8 @@ r"""Weighted and moving Taylor expansion shape-function derivatives.
 ``G[k, j, i, :]`` is the derivative of the shape function of member ``i`` of
 family ``k``, evaluated at member ``j`` (thesis (4.8)–(4.12)), in the
 *plain-sum* form :math:`F^{kj} = I + \sum_i u^i \otimes G^{kji}` with
-:math:`\sum_i G^{kji} = 0` (the thesis' difference form (4.11), folded).  Padded slots are zero.
+:math:`\sum_i G^{kji} = 0` (the thesis' difference form (4.11), folded).
+Padded slots are zero.
 
 WTE1 (static Taylor expansion around the master; formulation U1)
     :math:`M^k = \sum_{i\ne k} \omega^{ki} V^i \Delta X^{ki}\otimes\Delta X^{ki}`,
