@@ -16,7 +16,7 @@ assembly) → :mod:`~skfem_pg.formulations` (with :mod:`~skfem_pg.materials`)
 True
 """
 from . import (discretization, formulations, materials, solvers, analysis,
-               scenes, threads, errors)
+               scenes, threads, errors, registry)
 from .discretization import (particles, families, shape, corrections,
                              loads)
 from .scenes import meshing, reference, reporting
@@ -26,6 +26,7 @@ from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
 from .scenes.io import write_vtu
+from .registry import register as register_formulation
 
 __version__ = "0.1.0"
 
@@ -36,4 +37,4 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "solvers", "analysis", "scenes", "families", "shape",
            "corrections", "meshing", "particles", "loads",
            "ParticleError", "FamilyError", "CorrectionError",
-           "UnsupportedMeshError"]
+           "UnsupportedMeshError", "registry", "register_formulation"]

@@ -50,18 +50,10 @@ built, naming it).
 """
 import re
 
-#: formulation -> shape functions of its displacement basis
-SHAPES = {"U1": "WTE1", "Unl": "MTE1", "U2": "WTE2",
-          "UnlP0": "MTE1", "IUnlP0": "MTE1", "Unl+P1C": "MTE1",
-          "U2P1": "WTE2", "U2P1C": "WTE2",
-          "U1SUnl": "MTE1", "U1SIG": "WTE1"}
-#: formulations whose displacement gradient lives at the master alone,
-#: where the bond correction has no bond: their basis is WTE1 without it
-MASTER_ONLY = ("U1SIG",)
-#: the displacement formulations (the rest are mixed or stabilized)
-DISPLACEMENT = ("U1", "Unl", "U2")
-#: first-order formulations: the bond correction is their default
-FIRST_ORDER = tuple(f for f, s in SHAPES.items() if s in ("WTE1", "MTE1"))
+from . import registry
+
+# the formulation tokens (their shape functions, kinds, the UL frame) are
+# those of skfem_pg.registry, which skfem_pg.formulations.by_name fills
 FE_NAMES = ("T1", "Q1", "O1", "H1", "Q1P0", "H1P0", "T2", "Q2", "O2", "H2")
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
@@ -80,10 +72,6 @@ def fe_method(name):
         raise ValueError("unknown FE comparator {!r}: FEM {}".format(
             name, " / ".join(FE_NAMES)))
     return parts[0] if len(parts) == 1 and parts[0] in FE_NAMES else None
-
-
-#: the formulations the updated Lagrangian frame is built for
-UL_FORMULATIONS = ("Unl", "U1", "U2")
 
 
 def frame_of(name):
@@ -111,8 +99,8 @@ def parse(name):
     :class:`~skfem_pg.FamilyBasis` of a thesis name, with Table 7.1's
     defaults; raises ``ValueError`` naming what is not understood and
     ``NotImplementedError`` for combinations that are not built (UL for
-    other formulations than :data:`UL_FORMULATIONS` or other methods than
-    PBG; see the checks below)."""
+    a formulation registered without it, :mod:`skfem_pg.registry`, or
+    for other methods than PBG; see the checks below)."""
     if fe_method(name) is not None:
         raise ValueError("{!r} is an FE comparator, not a family basis: "
                          "use Scene.solve({!r})".format(name, name))
@@ -123,37 +111,41 @@ def parse(name):
                          .format(name))
     g = m.groupdict()
     form = g["form"]
-    if form not in SHAPES:
-        raise ValueError("unknown formulation {!r} in {!r}: one of {}"
-                         .format(form, name, ", ".join(SHAPES)))
-    if g["frame"] == "UL" and form not in UL_FORMULATIONS:
+    try:
+        record = registry.formulation(form)
+    except ValueError as err:
+        raise ValueError("{} (in {!r})".format(err, name)) from None
+    if g["frame"] == "UL" and not record.updated_lagrangian:
         raise NotImplementedError(
             "{!r}: the updated Lagrangian frame (UL) is built for the "
             "displacement formulations {} of PBG".format(
-                name, ", ".join(UL_FORMULATIONS)))
+                name, ", ".join(registry.tokens(updated_lagrangian=True))))
     if g["frame"] == "UL" and g["method"] != "PBG":
         raise NotImplementedError("{!r}: UL is built for PBG".format(name))
     method = {"PPG": "PPG1"}.get(g["method"], g["method"])
-    first_order = form in FIRST_ORDER
+    first_order, shape = record.first_order, record.shape
     if g["bc"] and not first_order:
         raise ValueError("{!r}: the bond correction is for first-order "
                          "formulations ({}), not {}".format(
-                             name, ", ".join(FIRST_ORDER), form))
-    if g["bc"] and form in MASTER_ONLY:
+                             name, ", ".join(
+                                 t for t in registry.tokens()
+                                 if registry.formulation(t).first_order),
+                             form))
+    if g["bc"] and record.master_only:
         raise ValueError("{!r}: {} evaluates its gradient at the master "
                          "only, where the bond correction has no bond; "
                          "drop 'BC'".format(name, form))
     if g["bc"] and g["nobc"]:
         raise ValueError("{!r} asks for BC and noBC".format(name))
-    kw = {"shape": SHAPES[form], "method": method,
-          "bond": first_order and not g["nobc"] and form not in MASTER_ONLY}
+    kw = {"shape": shape, "method": method,
+          "bond": first_order and not g["nobc"] and not record.master_only}
     if g["recipe"]:
-        if method != "PBG" or SHAPES[form] != "MTE1":
+        if method != "PBG" or shape != "MTE1":
             raise ValueError("{!r}: the kNN recipe (uniform quadrature "
                              "weights) is for PBG on MTE1 bases".format(name))
         kw.update(families="nearest", weights="uniform", weight_exponent=0)
     else:  # the thesis' families (WTE2: its horizon) and weights
-        if SHAPES[form] != "WTE2":
+        if shape != "WTE2":
             kw["families"] = "mesh"
         kw.update(weights="volume", weight_exponent=1)
     notes = []
@@ -201,8 +193,9 @@ def name_of(basis):
     ``"VCBCPBG V5m Unl TL"``: every option written, so that
     :func:`parse` gives the basis back."""
     vc = basis.vc
-    form = {SHAPES[f]: f for f in DISPLACEMENT}[basis.shape]
-    first_order = form in FIRST_ORDER
+    form = {registry.formulation(f).shape: f for f in reversed(
+        registry.tokens(kind="displacement"))}[basis.shape]
+    first_order = registry.formulation(form).first_order
     prefix = ("VC2" if vc == "VC2" else "VC" if vc else "") + \
         ("BC" if basis.bond else "")
     method = {"PPG1": "PPG"}.get(basis.method, basis.method)

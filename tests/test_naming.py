@@ -174,3 +174,55 @@ def test_knn_name_only_where_the_recipe_applies():
     for name in ("VCPBG V3m U1SIG", "VCPBG V3m U2P1", "VCPPG UnlP0",
                  "VCPBG V3m U2"):
         assert knn_name(name) is None
+
+
+def test_a_formulation_of_ones_own_is_one_registration():
+    """Item 2 of issue 29: a formulation written outside the package,
+    registered through the public call, parses, builds and is solved by
+    Scene.solve and by newton.  Here: Unl with its internal force and
+    tangent doubled, so it carries twice the load of Unl at the same u."""
+    import numpy as np
+    import skfem as fem
+    from skfem_pg.formulations import Hyperelastic, model_for
+    from skfem_pg.materials import NeoHooke
+    from skfem_pg.scenes import Scene
+
+    class Doubled(Hyperelastic):
+        def internal_force(self, state):
+            return 2.0 * super().internal_force(state)
+
+        def tangent(self, state):
+            return 2.0 * super().tangent(state)
+
+    pg.register_formulation("UnlX2", "MTE1",
+                            lambda basis, material, tangent:
+                            Doubled(basis, material, tangent=tangent))
+    try:
+        mesh = fem.MeshQuad.init_tensor(
+            np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
+            {"left": lambda x: np.isclose(x[0], 0),
+             "right": lambda x: np.isclose(x[0], 4)})
+
+        def scene(t):
+            return Scene("own", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+                         tractions={"right": [0.0, t]},
+                         probes={"tip": (4.0, 1.0)}, steps=2)
+        kw, _ = parse("VCBCPBG V5m UnlX2")
+        assert kw["shape"] == "MTE1" and kw["bond"]
+        own = scene(0.2).solve("VCBCPBG V5m UnlX2", tol=1e-12)
+        ref = scene(0.1).solve("VCBCPBG V5m Unl", tol=1e-12)
+        assert np.abs(own.u - ref.u).max() <= 1e-9 * np.abs(ref.u).max()
+        basis = own.basis
+        model = model_for("UnlX2", basis, NeoHooke(10.0, 5.0))
+        assert isinstance(model, Doubled)
+        u, _ = pg.solvers.newton(model, own.f_ext, D=basis.get_dofs("left"),
+                                 steps=2, tol=1e-12, verbose=False)
+        assert np.abs(u - own.u).max() <= 1e-9 * np.abs(own.u).max()
+        with pytest.raises(ValueError, match="registered already"):
+            pg.register_formulation("UnlX2", "MTE1", Doubled)
+        with pytest.raises(ValueError, match="shape must be one of"):
+            pg.register_formulation("Bad", "MTE3", Doubled)
+    finally:
+        pg.registry.unregister("UnlX2")
+    with pytest.raises(ValueError, match="unknown formulation 'UnlX2'"):
+        parse("VCPBG UnlX2")

@@ -33,55 +33,93 @@ from .incompressible import IncompressibleP0
 from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 from .stabilized import U1SIG, U1SUnl
-from ..naming import FE_NAMES, SHAPES
-
-#: built formulation tokens beyond the displacement ones
-MIXED = {"UnlP0": MeanDilatation, "IUnlP0": IncompressibleP0}
-#: the stabilized under-integrated formulations (6.3)
-STABILIZED = {"U1SUnl": U1SUnl, "U1SIG": U1SIG}
+from .. import registry
+from ..naming import FE_NAMES
 
 
 def _incompressible(material):
     return not np.isfinite(getattr(material, "K", 0.0))
 
 
+def _displacement(basis, material, tangent):
+    return Hyperelastic(basis, material, tangent=tangent)
+
+
+def _mean_dilatation(token, incompressible):
+    """UnlP0 / IUnlP0: the PBG model, at the master on a PPG basis."""
+    pbg, ppg = ((IncompressibleP0, MasterIncompressible) if incompressible
+                else (MeanDilatation, MasterDilatation))
+
+    def build(basis, material, tangent):
+        if not incompressible and _incompressible(material):
+            raise ValueError("{} condenses the pressure with a finite bulk "
+                             "modulus; for nu = 0.5 use IUnlP0".format(token))
+        cls = ppg if getattr(basis, "is_petrov", False) else pbg
+        return cls.of(basis, material)
+    return build
+
+
+def _u2p1(basis, material, tangent):
+    if _incompressible(material):
+        raise ValueError("U2P1 condenses p and Theta with a finite bulk "
+                         "modulus; nu = 0.5 is not built for it")
+    return MeanDilatation.of(basis, material, order=1)
+
+
+def _nodal(bubble):
+    def build(basis, material, tangent):
+        return NodalPressure.of(basis, material, bubble=bubble)
+    return build
+
+
+def _stabilized(cls):
+    def build(basis, material, tangent):
+        return cls.of(basis, material)
+    return build
+
+
+# Table 7.1, in the order of the thesis (the displacement formulations
+# first: name_of names a basis by the first of its shape)
+for _token, _shape in (("U1", "WTE1"), ("Unl", "MTE1"), ("U2", "WTE2")):
+    registry.register(_token, _shape, _displacement,
+                      updated_lagrangian=True,
+                      distributed=_shape != "WTE2", replace=True)
+registry.register("UnlP0", "MTE1", _mean_dilatation("UnlP0", False),
+                  kind="mixed", replace=True)
+registry.register("IUnlP0", "MTE1", _mean_dilatation("IUnlP0", True),
+                  kind="mixed", replace=True)
+registry.register("Unl+P1C", "MTE1", _nodal(True), kind="mixed",
+                  replace=True)
+registry.register("U2P1", "WTE2", _u2p1, kind="mixed", replace=True)
+registry.register("U2P1C", "WTE2", _nodal(False), kind="mixed",
+                  replace=True)
+registry.register("U1SUnl", "MTE1", _stabilized(U1SUnl), kind="stabilized",
+                  replace=True)
+registry.register("U1SIG", "WTE1", _stabilized(U1SIG), kind="stabilized",
+                  master_only=True, replace=True)
+
+
 def model_for(formulation, basis, material, tangent="consistent"):
-    """The model of ``formulation`` (a token of Table 7.1 or an FE
-    method) on ``basis`` with ``material``.  An unknown token, or a
-    family basis whose shape functions are not the token's
-    (:data:`~skfem_pg.naming.SHAPES`: ``U2``, ``U2P1``, ``U2P1C`` need
+    """The model of ``formulation`` (a token of :mod:`skfem_pg.registry`:
+    Table 7.1's or one a user registered, or an FE method) on ``basis``
+    with ``material``.  An unknown token, or a family basis whose shape
+    functions are not the token's (``U2``, ``U2P1``, ``U2P1C`` need
     WTE2), raises ``ValueError`` naming it."""
-    if formulation not in SHAPES and formulation not in FE_NAMES:
-        raise ValueError(
-            "unknown formulation {!r}: Table 7.1 tokens are {}; FE methods "
-            "{}".format(formulation, ", ".join(SHAPES), ", ".join(FE_NAMES)))
+    if formulation in FE_NAMES:
+        if formulation in ("Q1P0", "H1P0"):
+            cls = IncompressibleP0 if _incompressible(material) \
+                else MeanDilatation
+            return cls.of(basis, material)
+        return Hyperelastic(basis, material, tangent=tangent)
+    try:
+        record = registry.formulation(formulation)
+    except ValueError as err:
+        raise ValueError("{}; FE methods {}".format(
+            err, ", ".join(FE_NAMES))) from None
     shape = getattr(basis, "shape", None)
-    if isinstance(shape, str) and formulation in SHAPES \
-            and SHAPES[formulation] == "WTE2" and shape != "WTE2":
+    if isinstance(shape, str) and record.shape == "WTE2" and shape != "WTE2":
         raise ValueError(
             "{} is a formulation of WTE2 shape functions (Table 7.1); this "
             "basis has {}: build it with shape='WTE2' (or use the thesis "
             "name, e.g. 'PBG {}')".format(formulation, shape, formulation))
-    if formulation in STABILIZED:
-        return STABILIZED[formulation].of(basis, material)
-    if formulation in ("Q1P0", "H1P0"):
-        cls = IncompressibleP0 if _incompressible(material) \
-            else MeanDilatation
-        return cls.of(basis, material)
-    if formulation == "U2P1":
-        if _incompressible(material):
-            raise ValueError("U2P1 condenses p and Theta with a finite bulk "
-                             "modulus; nu = 0.5 is not built for it")
-        return MeanDilatation.of(basis, material, order=1)
-    if formulation in ("U2P1C", "Unl+P1C"):
-        return NodalPressure.of(basis, material,
-                                bubble=formulation == "Unl+P1C")
-    if formulation in MIXED:
-        if formulation == "UnlP0" and _incompressible(material):
-            raise ValueError("UnlP0 condenses the pressure with a finite "
-                             "bulk modulus; for nu = 0.5 use IUnlP0")
-        if getattr(basis, "is_petrov", False):  # PPG: at the master
-            return (MasterDilatation if formulation == "UnlP0"
-                    else MasterIncompressible).of(basis, material)
-        return MIXED[formulation].of(basis, material)
-    return Hyperelastic(basis, material, tangent=tangent)
+    return record.build(basis, material, tangent)

@@ -48,7 +48,7 @@ from ..formulations.updated_lagrange import UpdatedLagrange
 from ..naming import fe_method, formulation_of, frame_of, parse
 from ..solvers import newton
 from ..solvers.result import Result
-from .. import distributed
+from .. import distributed, registry
 from ..distributed.solve import DistributedResult
 
 #: method -> (mesh class needed, scalar element)
@@ -316,11 +316,12 @@ class Scene:
                 "{} on MPI: FE methods run on scikit-fem's own distributed "
                 "assembly (skfem.Dofs.decompose); the scene distributes PG"
                 .format(scheme))
-        if formulation not in ("Unl", "U1") or frame_of(scheme) == "UL":
+        if not registry.formulation(formulation).distributed \
+                or frame_of(scheme) == "UL":
             raise NotImplementedError(
-                "{} on MPI: the distributed Newton solves the displacement "
-                "formulations (Unl, U1) in the total Lagrangian frame"
-                .format(scheme))
+                "{} on MPI: the distributed Newton solves the formulations "
+                "{} in the total Lagrangian frame".format(
+                    scheme, ", ".join(registry.tokens(distributed=True))))
         t0 = time.perf_counter()
         part = distributed.Partition(self.mesh, comm)
         basis = part.basis(dim=self.dim, **basis_kwargs)
