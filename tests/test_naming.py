@@ -226,3 +226,20 @@ def test_a_formulation_of_ones_own_is_one_registration():
         pg.registry.unregister("UnlX2")
     with pytest.raises(ValueError, match="unknown formulation 'UnlX2'"):
         parse("VCPBG UnlX2")
+
+
+def test_a_registered_builder_must_return_a_model():
+    from skfem_pg.formulations import Model, model_for
+    from skfem_pg.materials import NeoHooke
+    import numpy as np
+    import skfem as fem
+    basis = pg.FamilyBasis(fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 4)]
+                                                    * 2), dim=2)
+    assert isinstance(model_for("Unl", basis, NeoHooke(1.0, 1.0)), Model)
+    pg.register_formulation("NotAModel", "MTE1", lambda b, m, t: object())
+    try:
+        with pytest.raises(TypeError, match="'NotAModel' built a object "
+                           "without basis, n_u, N"):
+            model_for("NotAModel", basis, NeoHooke(1.0, 1.0))
+    finally:
+        pg.registry.unregister("NotAModel")

@@ -1,7 +1,8 @@
 """Formulations: what a discretization (one or several bases) and a
 material make into the residual and tangent that the solvers drive.
-The model interface (fields, residual, tangent) is described in
-:mod:`~skfem_pg.formulations.displacement`.
+What a driver asks of a model is :class:`~.protocol.Model`
+(:mod:`~skfem_pg.formulations.protocol`); the formulation tokens live in
+:mod:`skfem_pg.registry`.
 
 =====================  ====================================================
 ``linear``             linear elasticity as a plain scikit-fem form
@@ -21,7 +22,9 @@ The model interface (fields, residual, tangent) is described in
 ``stabilized``         :class:`U1SUnl`, :class:`U1SIG`: under-integrated
                        U1 (material and history at the masters) with
                        full-integration or implicit-gradient stabilization
-``by_name``            the model of a Table 7.1 formulation token
+``protocol``           :class:`Model`: what a driver may ask of a model
+``by_name``            Table 7.1's tokens registered (skfem_pg.registry)
+                       and :func:`model_for`: the model of a token
 ``history``            :class:`History`: a plastic material's internal
                        variables at a model's integration points,
                        committed per converged step
@@ -36,6 +39,7 @@ from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
 from .stabilized import U1SUnl, U1SIG
 from .by_name import model_for
+from .protocol import Model
 from .tangents import fd_tangent
 from .history import History
 from .updated_lagrange import UpdatedLagrange
@@ -45,4 +49,4 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "MasterIncompressible",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
-           "History", "UpdatedLagrange"]
+           "History", "UpdatedLagrange", "Model"]

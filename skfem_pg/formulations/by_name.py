@@ -32,6 +32,7 @@ from .displacement import Hyperelastic
 from .incompressible import IncompressibleP0
 from .master_dilatation import MasterDilatation, MasterIncompressible
 from .nodal import NodalPressure
+from .protocol import check_model
 from .stabilized import U1SIG, U1SUnl
 from .. import registry
 from ..naming import FE_NAMES
@@ -122,4 +123,4 @@ def model_for(formulation, basis, material, tangent="consistent"):
             "{} is a formulation of WTE2 shape functions (Table 7.1); this "
             "basis has {}: build it with shape='WTE2' (or use the thesis "
             "name, e.g. 'PBG {}')".format(formulation, shape, formulation))
-    return record.build(basis, material, tangent)
+    return check_model(record.build(basis, material, tangent), formulation)
