@@ -69,7 +69,7 @@ def iterations(sc, scheme, solver, load, steps, candidates=None, **kw):
     model.material = material
     timed = Timed(model, ("state", "internal_force", "tangent"))
     I = np.setdiff1d(np.arange(basis.N), D)
-    lin = pg.solvers.static._condensed_solver(solver, basis, I)
+    lin = pg.solvers.static.condensed_solver(solver, basis, I)
     if candidates is not None and hasattr(basis, "layout"):  # PG's AMG
         lin = pg.solvers.linear_solver(
             solver, basis.doflocs[:, I], candidates=candidates,

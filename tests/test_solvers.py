@@ -273,7 +273,7 @@ def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
     mesh, b = beam
     model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
     tried, done = [], [0.0]  # (from, to, converged), last converged load
-    step = static._newton_step
+    step = static.newton_step
 
     def fails_above(model, u, lam, *args):
         if lam == 1.0 and lam - done[0] > 0.05:  # the last bit is hard
@@ -284,7 +284,7 @@ def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
         tried.append((done[0], lam, ok))
         done[0] = lam if ok else done[0]
         return ok, u, info, state
-    monkeypatch.setattr(static, "_newton_step", fails_above)
+    monkeypatch.setattr(static, "newton_step", fails_above)
     f = pg.traction(b, "right", [0.0, 0.01])
     newton(model, f, D=b.get_dofs("left"), predictor=False, verbose=False)
     attempts = [(s, t) for s, t, _ in tried]
@@ -352,13 +352,13 @@ def test_line_search_tames_an_oscillating_newton(max_x):
     (or, beyond max_x, fail as J <= 0); halving the increment that raises
     the residual (or fails) converges to the root."""
     from scipy.sparse.linalg import spsolve
-    from skfem_pg.solvers.static import _newton_step
+    from skfem_pg.solvers.static import newton_step
     model = _Arctan(max_x)
     x0 = np.array([1.5, 0.3])
     none = np.array([], dtype=int)
 
     def step(line_search):
-        return _newton_step(model, x0, 0.0, np.zeros(2), none, np.zeros(0),
+        return newton_step(model, x0, 0.0, np.zeros(2), none, np.zeros(0),
                             np.arange(2), spsolve, 1e-10, 25, line_search)
 
     ok, x, info, _ = step(False)

@@ -170,7 +170,7 @@ def _generic(form, *bases, **kwargs):
     return form.assemble(*bases, **kwargs)
 
 
-def _view(basis):
+def batched_view(basis):
     if not supports(basis):
         return None
     return (_FamilyView if isinstance(basis, FamilyBasis)
@@ -265,7 +265,7 @@ def block_pattern(basis, view=None):
     the chunk touches and, per local pair ``(row node l, column node i)``,
     its index ``inv`` into ``u``."""
     if getattr(basis, "_pattern", None) is None:
-        view = _view(basis) if view is None else view
+        view = batched_view(basis) if view is None else view
         n = view.n_nodes
         rows_e, cols_n = [], []
         start = 0
@@ -367,7 +367,7 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     ``bincount`` per component pair (an entry-level index would hold
     ``c²`` times the integers).
     """
-    view = _view(basis) if view is None else view
+    view = batched_view(basis) if view is None else view
     nc = view.nc
     indptr, indices, pieces = block_pattern(basis, view)
     data = np.zeros((len(indices), nc, nc))
@@ -447,7 +447,7 @@ def assemble(form, basis, vbasis=None, **kwargs):
     if vbasis is None:
         test = getattr(basis, "test", None)
         vbasis = basis if test is None else test
-    view = _view(basis)
+    view = batched_view(basis)
     if vbasis is basis:
         vview = view
     elif (isinstance(basis, FamilyBasis) and isinstance(vbasis, FamilyBasis)

@@ -267,7 +267,7 @@ def scalar_constraint_matrix(phi, fam, n_particles, index=None, nf=None):
                          shape=(n_particles, len(fam) if nf is None else nf))
 
 
-def _solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
+def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
                      min_norm=True, iterative=False):
     r"""Minimum-norm solution of the consistent, singular, square system
     ``A α = b``, :math:`A_{ik} = \varphi^{ki} B^k`, by one *scalar* sparse
@@ -568,7 +568,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         alpha, its = lsqr()
     elif solver in ("direct", "amg"):
         try:
-            alpha, its, used = _solve_pinned_lu(
+            alpha, its, used = solve_pinned_lu(
                 matrix(scalar=True), masters, B, b, x, active,
                 min_norm=boundary == "min-norm", iterative=solver == "amg")
             if used != solver:

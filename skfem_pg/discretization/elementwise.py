@@ -28,7 +28,7 @@ All loops run over size groups, never over elements.
 import numpy as np
 import scipy.sparse as sp
 
-from .assembly import _view, assemble_local
+from .assembly import batched_view, assemble_local
 
 
 class Elements:
@@ -37,7 +37,7 @@ class Elements:
 
     def __init__(self, basis):
         self.basis = basis
-        self.view = _view(basis)
+        self.view = batched_view(basis)
         if self.view is None:
             raise TypeError("per-element reductions need a FamilyBasis or a "
                             "scikit-fem cell basis, got {}".format(

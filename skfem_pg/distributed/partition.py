@@ -28,7 +28,7 @@ The VC correction couples all families through one sparse system
 are rank-local — each rank's families give their columns of the scalar
 constraint matrix :math:`\Phi^T`, their :math:`B^k` and their part of
 the residual, summed over ranks — and rank 0 solves the assembled system
-with the serial code (:func:`_solve_pinned_lu`, the same pivoting LU and
+with the serial code (:func:`solve_pinned_lu`, the same pivoting LU and
 minimum-norm projection), then broadcasts :math:`\alpha`.  So the
 distributed VC basis *is* the serial one up to the order of floating-point
 sums (tests: 1e-12).  The price is a scalar :math:`n \times n` system on

@@ -2,7 +2,7 @@ r"""The VC constraint system solved on all ranks with PETSc
 (``vc_solver="petsc"`` of a distributed basis).
 
 The serial solve (:func:`~skfem_pg.discretization.corrections.
-_solve_pinned_lu`) works on the scalar matrix :math:`\Phi^T` (row: particle
+solve_pinned_lu`) works on the scalar matrix :math:`\Phi^T` (row: particle
 ``i``, column: the family of master ``k``, entry :math:`\varphi^{ki}`).
 :math:`\Phi^T` is singular — the scalar linear fields are its left null
 space — so the equations at ``d + 1`` anchor particles are dropped and the
@@ -30,7 +30,7 @@ import scipy.sparse as sp
 from . import petsc as pt
 from .comm import mpi, petsc
 from ..discretization.corrections import (
-    AMG_VC_LIMIT_3D, VCReport, _solve_pinned_lu, anchor_particles,
+    AMG_VC_LIMIT_3D, VCReport, solve_pinned_lu, anchor_particles,
     linear_fields, scalar_constraint_matrix, vc_apply, vc_parts,
     vc_residual)
 
@@ -192,7 +192,7 @@ def vc_correction(part, G, dx, x, volumes, fam, area, phi, variant="V5",
             Bg[g[3]] = g[4]
         M = sp.csr_matrix((V, (R, C)), shape=(part.n, nf))
         try:
-            alpha, its, _ = _solve_pinned_lu(
+            alpha, its, _ = solve_pinned_lu(
                 M, part._masters, Bg, b, xg, active,
                 min_norm=boundary == "min-norm",
                 iterative=solver == "amg")

@@ -50,7 +50,7 @@ from ..threads import kernel
 from .displacement import Hyperelastic, material_tangent
 
 
-def _d_JFinvT(J, Finv):
+def d_JFinvT(J, Finv):
     r""":math:`\partial(JF^{-T})_{iJ}/\partial F_{kL} = J(F^{-T}_{iJ}
     F^{-T}_{kL} - F^{-1}_{Jk}F^{-1}_{Li})`."""
     FinvT = np.swapaxes(Finv, 0, 1)
@@ -165,7 +165,7 @@ class MeanDilatation(Hyperelastic):
 
     @kernel
     def tangent(self, state):
-        A = self.material.tangent(state["F"]) + state["p"] * _d_JFinvT(
+        A = self.material.tangent(state["F"]) + state["p"] * d_JFinvT(
             state["J"], state["Finv"])
         # one scatter for the pointwise and the condensed volumetric part
         return assemble(material_tangent, self.basis, A=A,

@@ -42,7 +42,7 @@ from ..discretization.assembly import assemble
 from ..discretization.elementwise import Elements
 from ..materials import J2Plasticity, NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
-from .dilatation import _d_JFinvT
+from .dilatation import d_JFinvT
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 
@@ -131,7 +131,7 @@ class IncompressibleP0(Hyperelastic):
 
     @kernel
     def tangent(self, state):
-        A = self.material.tangent(state["F"]) + state["p"] * _d_JFinvT(
+        A = self.material.tangent(state["F"]) + state["p"] * d_JFinvT(
             state["J"], state["Finv"])
         Kuu = assemble(material_tangent, self.basis, A=A)
         E = self.elements

@@ -37,7 +37,7 @@ from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.petrov import reverse_slots
 from ..materials import NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
-from .dilatation import _d_JFinvT, compressible_moduli
+from .dilatation import d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, material_tangent
 from .incompressible import incompressible_shear_modulus
 
@@ -166,7 +166,7 @@ class MasterDilatation(Hyperelastic):
         Q = J * np.swapaxes(Finv, 0, 1)
         Upp = 0.5 * self.K * (1.0 + 1.0 / J ** 2)
         K, uu = self._tangent_parts(state, Upp * Q[:, :, None, None]
-                                    * Q[None, None] + p * _d_JFinvT(J, Finv))
+                                    * Q[None, None] + p * d_JFinvT(J, Finv))
         if self._pattern is None:
             dofs = self._family_dofs()
             shape = dofs.shape + dofs.shape[-1:]  # (nf, m d, m d)
@@ -251,7 +251,7 @@ class MasterIncompressible(MasterDilatation):
     def tangent(self, state):
         Finv, J, p = state["Finv_m"], state["J_m"], state["p"]
         Q = J * np.swapaxes(Finv, 0, 1)  # dJ/dF at the master
-        K, uu = self._tangent_parts(state, p * _d_JFinvT(J, Finv))
+        K, uu = self._tangent_parts(state, p * d_JFinvT(J, Finv))
         up = np.einsum("k,kib,cbk->kic", self.V, self.S, Q)  # (nf, m, d)
         pu = np.einsum("k,eLk,klL->kle", self.V, Q, self._G0)
         if self._pattern is None:

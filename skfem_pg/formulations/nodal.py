@@ -49,7 +49,7 @@ from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
 from ..materials import NeoHookeIsoVol, ReturnMapError, inverse_and_det
 from ..threads import kernel
-from .dilatation import _d_JFinvT, compressible_moduli
+from .dilatation import d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 #: local Newton of the bubble: largest iterations, and the tolerance on
@@ -173,7 +173,7 @@ class NodalPressure(Hyperelastic):
             Finv, 0, 1)
 
     def _tangent_field(self, F, Finv, J, p):
-        return self.material.tangent(F) + p * _d_JFinvT(J, Finv)
+        return self.material.tangent(F) + p * d_JFinvT(J, Finv)
 
     @kernel
     def state(self, x):

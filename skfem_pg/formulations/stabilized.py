@@ -60,7 +60,7 @@ U1's zero-energy modes disappear with either stabilization
 """
 import numpy as np
 
-from ..discretization.assembly import assemble, assemble_local, _view
+from ..discretization.assembly import assemble, assemble_local, batched_view
 from ..discretization.basis import FamilyBasis
 from ..discretization.elementwise import Elements
 from ..discretization.shape.least_squares import mls1_master_hessians
@@ -361,7 +361,7 @@ class U1SIG(_MasterModel):
         if self._Ks[0] is key and key is not None:
             return self._Ks[1]
         H, M2 = self.hessians, self.M2
-        view = _view(self.u1)
+        view = batched_view(self.u1)
 
         def local_matrices(bi, blk, sl):
             k = blk.index[sl]
@@ -395,7 +395,7 @@ class U1SIG(_MasterModel):
         d = A.shape[1]
         U = np.asarray(u, dtype=float).reshape(-1, d)
         f = np.zeros_like(U)
-        for blk in _view(self.u1).blocks:
+        for blk in batched_view(self.u1).blocks:
             k, conn = blk.index, blk.conn
             Hk = H[k, :blk.nloc]  # (ne, m, d, d): [k, i, B, E]
             ne, m = conn.shape

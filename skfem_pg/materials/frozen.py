@@ -26,7 +26,7 @@ enters the products and its out-of-plane component adds to :math:`c`.
 """
 import numpy as np
 
-from .hyperelastic import Material, _dyad, inverse_and_det
+from .hyperelastic import Material, dyad, inverse_and_det
 
 
 class FrozenPlasticity(Material):
@@ -77,8 +77,8 @@ class FrozenPlasticity(Material):
         mua = self.mu * J ** (-2.0 / 3.0)
         J2 = J ** 2
         U = -2.0 / 3.0 * mua * (FC - c / 3.0 * FinvT) + self.K * J2 * FinvT
-        A = _dyad(U, FinvT)
-        A += _dyad(FinvT, -2.0 / 3.0 * mua * FC)
+        A = dyad(U, FinvT)
+        A += dyad(FinvT, -2.0 / 3.0 * mua * FC)
         e = 0.5 * self.K * (J2 - 1) - c / 3.0 * mua
         A -= np.einsum("Jk...,Li...->iJkL...", e * Finv, Finv)
         for i in range(d):

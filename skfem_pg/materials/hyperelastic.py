@@ -58,7 +58,7 @@ def _eye(F):
     return np.eye(d).reshape((d, d) + (1,) * (F.ndim - 2))
 
 
-def _dyad(A, B):
+def dyad(A, B):
     """:math:`(A\\otimes B)_{iJkL} = A_{iJ} B_{kL}`."""
     return A[:, :, None, None] * B[None, None]
 
@@ -177,7 +177,7 @@ class NeoHooke(Material):
         FinvT = np.swapaxes(Finv, 0, 1)
         c = 0.5 * self.lam * (J ** 2 - 1) - self.mu
         return (self.mu * _identity4(F)
-                + self.lam * J ** 2 * _dyad(FinvT, FinvT)
+                + self.lam * J ** 2 * dyad(FinvT, FinvT)
                 + c * _inv_t_derivative(Finv))
 
     def energy(self, F):
@@ -244,8 +244,8 @@ class NeoHookeIsoVol(Material):
         mua = self.mu * J ** (-2.0 / 3.0)
         J2 = J ** 2
         U = -2.0 / 3.0 * mua * (F - c / 3.0 * FinvT) + self.K * J2 * FinvT
-        A = _dyad(U, FinvT)
-        A += _dyad(FinvT, -2.0 / 3.0 * mua * F)
+        A = dyad(U, FinvT)
+        A += dyad(FinvT, -2.0 / 3.0 * mua * F)
         e = 0.5 * self.K * (J2 - 1) - c / 3.0 * mua
         A -= np.einsum("Jk...,Li...->iJkL...", e * Finv, Finv)
         for i in range(d):

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FamilyError, ParticleError
-from .static import _padded
+from .static import padded_vector
 
 
 def time_functions(model, f_ext, u_D):
@@ -42,8 +42,8 @@ def time_functions(model, f_ext, u_D):
 
     def wrap(v, what):
         if callable(v):
-            return lambda t: _padded(v(t), n_u, N, what + "(t)")
-        c = _padded(v, n_u, N, what)
+            return lambda t: padded_vector(v(t), n_u, N, what + "(t)")
+        c = padded_vector(v, n_u, N, what)
         return lambda t: c
     return wrap(f_ext, "f_ext"), wrap(u_D, "u_D")
 

@@ -36,7 +36,7 @@ from .checkpoint import Every, load as load_checkpoint
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
                        check_run, commit, history_of, history_text,
                        stored_energy, time_functions)
-from .static import _condensed_solver, _newton_step
+from .static import condensed_solver, newton_step
 
 
 class _Inertial:
@@ -253,11 +253,11 @@ def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
         if key not in solvers:
             solvers.clear()  # one active set at a time
             solvers[key] = solver if callable(solver) else \
-                _condensed_solver(solver, model.basis, I,
+                condensed_solver(solver, model.basis, I,
                                   extra_fields=N > n_u)
         mm = np.where(free & ~held, m, 0.0)
         inert = _Inertial(model, mm, c, u_tilde)
-        ok, xn, info, state = _newton_step(inert, start, 1.0, f_of(t + h),
+        ok, xn, info, state = newton_step(inert, start, 1.0, f_of(t + h),
                                            C, values[C], I, solvers[key],
                                            tol, maxiter, line_search)
         times["assemble"] += info["t_assemble"]

@@ -42,7 +42,7 @@ class ConvergenceError(RuntimeError):
 PG_CANDIDATES = 12
 
 
-def _condensed_solver(kind, basis, I, extra_fields=False):
+def condensed_solver(kind, basis, I, extra_fields=False):
     if extra_fields:  # a saddle point or a coupled u-p system: no
         # rigid-body AMG; the direct solve (partial pivoting)
         if kind == "amg":
@@ -138,7 +138,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         ``True``: halve an increment whose iterate fails, or a later
         one that raises the residual (at most
         :data:`LINE_SEARCH_HALVINGS` times), before the step counts as
-        failed (:func:`_newton_step`).  ``False`` (default): full Newton
+        failed (:func:`newton_step`).  ``False`` (default): full Newton
         increments, a failed iterate cuts the step.
 
     Returns
@@ -159,20 +159,20 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
     I = np.setdiff1d(np.arange(N), Dd)
-    f_ext = _padded(f_ext, n_u, N, "f_ext")
+    f_ext = padded_vector(f_ext, n_u, N, "f_ext")
     if callable(u_D):
         values = u_D
 
         def prescribed(t):
-            return _padded(values(t), n_u, N, "u_D(t)")
+            return padded_vector(values(t), n_u, N, "u_D(t)")
     else:
-        u_D1 = _padded(u_D, n_u, N, "u_D")
+        u_D1 = padded_vector(u_D, n_u, N, "u_D")
 
         def prescribed(t):
             return t * u_D1
     x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
-    u = x0 if u0 is None else _padded(u0, n_u, N, "u0", x0)
-    lin = solver if callable(solver) else _condensed_solver(
+    u = x0 if u0 is None else padded_vector(u0, n_u, N, "u0", x0)
+    lin = solver if callable(solver) else condensed_solver(
         solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam = float(load0)
@@ -202,7 +202,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         if predictor and prev is not None:
             start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
         n_krylov = len(stats["iterations"])
-        ok, uk, info, state = _newton_step(model, start, target, f_ext, Dd,
+        ok, uk, info, state = newton_step(model, start, target, f_ext, Dd,
                                            prescribed(target)[Dd], I, lin,
                                            tol, maxiter, line_search)
         info.update(load=target, seconds=time.perf_counter() - t0,
@@ -272,7 +272,7 @@ def _check_controls(steps, tol, maxiter, min_step, load0):
         raise ValueError("load0 must lie in [0, 1], got {!r}".format(load0))
 
 
-def _padded(v, n_u, N, what, rest=None):
+def padded_vector(v, n_u, N, what, rest=None):
     """A vector of one entry per displacement dof (the extra fields'
     entries from ``rest``, default zeros, appended) or per unknown;
     ``None`` gives zeros."""
@@ -331,7 +331,7 @@ def verdict(res, energy, ref, tol, small=False):
 LINE_SEARCH_HALVINGS = 4
 
 
-def _newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
+def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
                  line_search=False):
     r"""Newton iterations at load factor ``lam`` from the converged ``u``;
     ``u_DD`` are the prescribed values at ``Dd`` at this load.

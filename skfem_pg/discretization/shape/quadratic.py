@@ -26,7 +26,7 @@ general position — larger families than FE connectivity gives at corners
 import numpy as np
 
 from .common import FamilyGeometry, chunks, weights, inverse_spd
-from .taylor import _check
+from .taylor import check_singular
 
 
 def quadratic_terms(d):
@@ -71,7 +71,7 @@ def wte2_gradients(x, volumes, fam, n=1):
         Wp = W[..., None] * p
         M = np.swapaxes(Wp, -1, -2) @ p  # (k, q, q)
         Minv, singular = inverse_spd(M)
-        _check(x, fam, sl, geo, singular, "WTE2", False)
+        check_singular(x, fam, sl, geo, singular, "WTE2", False)
         c = Wp @ Minv  # (k, i, q): coefficients, M symmetric
         dp = taylor2_derivatives(D) * geo.mask[..., None, None]  # (k, j, q, d)
         # G[k, j, i, :] = c[k, i, :] @ dp[k, j]

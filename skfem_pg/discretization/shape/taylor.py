@@ -25,7 +25,7 @@ from .common import (FamilyGeometry, chunks, weights, inverse_spd,
                      raise_singular)
 
 
-def _check(x, fam, sl, geo, singular, what, per_member):
+def check_singular(x, fam, sl, geo, singular, what, per_member):
     if np.any(singular):
         idx = np.argwhere(singular)[0]
         k = idx[0]
@@ -48,7 +48,7 @@ def wte1_gradients(x, volumes, fam, n=1):
         WD = W[..., None] * D
         M = np.swapaxes(WD, -1, -2) @ D
         Minv, singular = inverse_spd(M)
-        _check(x, fam, sl, geo, singular, "WTE1", False)
+        check_singular(x, fam, sl, geo, singular, "WTE1", False)
         g = WD @ np.swapaxes(Minv, -1, -2)
         g[:, 0] = -g[:, 1:].sum(axis=1)
         g /= geo.h[:, None, None]
@@ -74,7 +74,7 @@ def mte1_gradients(x, volumes, fam, n=1):
         WD = W[..., None] * D
         M = np.swapaxes(WD, -1, -2) @ D
         Minv, singular = inverse_spd(M)
-        _check(x, fam, sl, geo, singular & geo.mask, "MTE1", True)
+        check_singular(x, fam, sl, geo, singular & geo.mask, "MTE1", True)
         g = WD @ np.swapaxes(Minv, -1, -2)  # G = W M^-1 D
         diag = g.sum(axis=2)  # G[k,j,j] = -sum_{i != j} G[k,j,i]
         g[:, np.arange(m), np.arange(m)] = -diag
