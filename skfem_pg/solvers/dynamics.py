@@ -262,3 +262,45 @@ def stored_energy(model, state):
         return float(f(state))
     except (NotImplementedError, TypeError):
         return None
+
+
+def free_mask(n_u, Dd):
+    """``True`` at the displacement dofs that are not prescribed."""
+    free = np.ones(n_u, dtype=bool)
+    free[Dd] = False
+    return free
+
+
+def bind_walls(wall, basis, n_u, Dd):
+    """``(walls, candidates)``: ``wall`` (a
+    :class:`~skfem_pg.solvers.RigidWall`, a list of them or ``None``) as a
+    list, and the dofs each may hold (:meth:`RigidWall.bind`)."""
+    walls = [] if wall is None else (list(wall) if isinstance(
+        wall, (list, tuple)) else [wall])
+    return walls, [w.bind(basis, n_u, Dd) for w in walls]
+
+
+class Recorder:
+    """The output of a time-stepping run, shared by Newmark and central
+    differences: at each output an energy record (:class:`EnergyBalance`)
+    with the step data, the progress line, the user's
+    ``callback(t, x, v, record)`` and the seconds spent (``times
+    ["output"]``).  ``hist`` holds the records."""
+
+    def __init__(self, model, energy, free, progress, callback, times):
+        self.model, self.energy, self.free = model, energy, free
+        self.progress, self.callback, self.times = progress, callback, times
+        self.hist = []
+
+    def __call__(self, t, x, v, state, held, final=False, **data):
+        """Record the state at ``t``; ``data``: ``dt``, ``steps`` and what
+        else the integrator reports (in the record's order)."""
+        t1 = time.perf_counter()
+        rec = self.energy.record(t, v, self.free & ~held,
+                                 stored_energy(self.model, state))
+        rec.update(data)
+        self.hist.append(rec)
+        self.progress(t, data["dt"], data["steps"], rec, force=final)
+        if self.callback is not None:
+            self.callback(t, x, v, rec)
+        self.times["output"] += time.perf_counter() - t1

@@ -45,9 +45,10 @@ from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .checkpoint import Every, load as load_checkpoint
-from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       MAX_STEPS, check_run, commit, history_of,
-                       history_text, stored_energy, time_functions)
+from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
+                       Trajectory, MAX_STEPS, bind_walls, check_run, commit,
+                       free_mask, history_of, history_text, stored_energy,
+                       time_functions)
 from ..discretization.particles import inverted_cells
 
 
@@ -190,16 +191,13 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     m = check_run(n_u, n_u, m, t_end, dt, u0, v0)
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     f_of, uD_of = time_functions(model, f_ext, u_D)
-    walls = [] if wall is None else (list(wall) if isinstance(
-        wall, (list, tuple)) else [wall])
-    cand = [w.bind(model.basis, n_u, Dd) for w in walls]
+    walls, cand = bind_walls(wall, model.basis, n_u, Dd)
     u = model.initial() if u0 is None else np.asarray(u0, float).copy()
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
     if u.shape != (n_u,) or v.shape != (n_u,):
         raise ValueError("u0 and v0 need {} entries".format(n_u))
     u[Dd] = uD_of(0.0)[Dd]
-    free = np.ones(n_u, dtype=bool)
-    free[Dd] = False
+    free = free_mask(n_u, Dd)
     inv_m = np.where(free, 1.0 / m, 0.0)
     times = dict.fromkeys(("force", "commit", "estimate", "contact",
                            "output"), 0.0)
@@ -212,19 +210,14 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     held = np.zeros(n_u, dtype=bool)  # dofs a wall holds
     energy = EnergyBalance(m, v, free, stored_energy(model, state))
     energy.D_c += hold_initial(walls, cand, u, v, a, m, held)
-    hist = []
-    t, steps = 0.0, 0
     progress = Progress(t_end, verbose)
+    out = Recorder(model, energy, free, progress, callback, times)
+    hist = out.hist
+    t, steps = 0.0, 0
 
     def output(force_progress=False):
-        t1 = time.perf_counter()
-        rec = energy.record(t, v, free & ~held, stored_energy(model, state))
-        rec.update(dt=step, steps=steps, active=int(held.sum()))
-        hist.append(rec)
-        progress(t, step, steps, rec, force=force_progress)
-        if callback is not None:
-            callback(t, u, v, rec)
-        times["output"] += time.perf_counter() - t1
+        out(t, u, v, state, held, force_progress, dt=step, steps=steps,
+            active=int(held.sum()))
 
     step = dt
     F_est = None  # the deformation at the last estimate

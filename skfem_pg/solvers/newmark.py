@@ -33,9 +33,10 @@ import scipy.sparse as sp
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
 from .checkpoint import Every, load as load_checkpoint
-from .dynamics import (DynamicsError, EnergyBalance, Progress, Trajectory,
-                       check_run, commit, history_of, history_text,
-                       stored_energy, time_functions)
+from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
+                       Trajectory, bind_walls, check_run, commit,
+                       free_mask, history_of, history_text, stored_energy,
+                       time_functions)
 from .static import condensed_solver, newton_step
 
 
@@ -135,9 +136,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
     f_of, uD_of = time_functions(model, f_ext, u_D)
-    walls = [] if wall is None else (list(wall) if isinstance(
-        wall, (list, tuple)) else [wall])
-    cand = [w.bind(basis, n_u, Dd) for w in walls]
+    walls, cand = bind_walls(wall, basis, n_u, Dd)
     dt_min = dt / 1024 if dt_min is None else dt_min
     x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
     x = x0.copy()
@@ -146,8 +145,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         x[:u0.shape[0]] = u0
     x[Dd] = uD_of(0.0)[Dd]
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
-    free = np.ones(n_u, dtype=bool)
-    free[Dd] = False
+    free = free_mask(n_u, Dd)
     held = np.zeros(n_u, dtype=bool)
     times = dict.fromkeys(("assemble", "linear", "output", "contact"), 0.0)
     state = model.state(x)
@@ -156,7 +154,9 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     a = np.where(free, (fe[:n_u] - fi[:n_u]) / m, 0.0)
     energy = EnergyBalance(m, v, free, stored_energy(model, state))
     energy.D_c += hold_initial(walls, cand, x, v, a, m, held)
-    hist = []
+    out = Recorder(model, energy, free, Progress(t_end, verbose), callback,
+                   times)
+    hist = out.hist
     t, steps, step, cuts = 0.0, 0, float(dt), 0
     if resume is not None:
         x, t, saved = load_checkpoint(resume, model, state=True)
@@ -165,25 +165,16 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         step, steps, cuts = float(saved["step"]), int(saved["steps"]), \
             int(saved["cuts"])
         energy.restore(saved)
-        hist = history_of(saved["records"])
+        hist[:] = history_of(saved["records"])
         state = model.state(x)
         fe = f_of(t)
-    progress = Progress(t_end, verbose)
     solvers = {}
     every = Every.of(checkpoint)
 
     def output(info=None, final=False):
-        t1 = time.perf_counter()
-        rec = energy.record(t, v, free & ~held, stored_energy(model, state))
-        rec.update(dt=step, steps=steps, cuts=cuts,
-                   active=int(held.sum()),
-                   iterations=0 if info is None else
-                   len(info["residuals"]) - 1)
-        hist.append(rec)
-        progress(t, step, steps, rec, force=final)
-        if callback is not None:
-            callback(t, x, v, rec)
-        times["output"] += time.perf_counter() - t1
+        out(t, x, v, state, held, final, dt=step, steps=steps, cuts=cuts,
+            active=int(held.sum()), iterations=0 if info is None else
+            len(info["residuals"]) - 1)
 
     if resume is None:
         output()
