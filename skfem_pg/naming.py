@@ -52,9 +52,8 @@ import re
 
 from . import registry
 
-# the formulation tokens (their shape functions, kinds, the UL frame) are
-# those of skfem_pg.registry, which skfem_pg.formulations.by_name fills
-FE_NAMES = ("T1", "Q1", "O1", "H1", "Q1P0", "H1P0", "T2", "Q2", "O2", "H2")
+# the formulation tokens (their shape functions, kinds, the UL frame) and
+# the FE comparators are those of skfem_pg.registry
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
                    r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
@@ -67,11 +66,12 @@ def fe_method(name):
     names no FE comparator."""
     parts = name.split()
     if parts[:1] == ["FEM"]:
-        if len(parts) == 2 and parts[1] in FE_NAMES:
+        if len(parts) == 2 and parts[1] in registry.fe_names():
             return parts[1]
         raise ValueError("unknown FE comparator {!r}: FEM {}".format(
-            name, " / ".join(FE_NAMES)))
-    return parts[0] if len(parts) == 1 and parts[0] in FE_NAMES else None
+            name, " / ".join(registry.fe_names())))
+    return parts[0] if len(parts) == 1 and parts[0] in registry.fe_names() \
+        else None
 
 
 def frame_of(name):

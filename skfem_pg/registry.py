@@ -29,10 +29,18 @@ field             used by
 of one's own is one :func:`register` call, after which names with its
 token parse, build and solve (``Scene.solve("VCPBG MyToken")``).  This
 module imports nothing of the package, so every layer may read it.
+
+The FE comparators (``T1`` … ``H2``, ``Q1P0``, ``H1P0``) are registered
+here too (:func:`fe_method`): the scikit-fem mesh type each runs on, its
+scalar element, its Gauss rule and whether it is the mean-dilatation
+(P0) variant; :class:`~skfem_pg.scenes.Scene`, the name parser and
+``model_for`` read them.
 """
 import re
 from dataclasses import dataclass
 from typing import Callable
+
+import skfem as fem
 
 #: the shape functions a formulation's displacement basis may have
 SHAPE_FUNCTIONS = ("WTE1", "MTE1", "WTE2")
@@ -108,3 +116,64 @@ def tokens(**where):
     ``where`` (e.g. ``tokens(kind="displacement")``)."""
     return tuple(t for t, r in _FORMULATIONS.items()
                  if all(getattr(r, k) == v for k, v in where.items()))
+
+
+@dataclass(frozen=True)
+class FEMethod:
+    """An FE comparator: the mesh type it needs (triangles and
+    tetrahedra are split from quadrilaterals and hexahedra on the same
+    nodes), its scalar element, its Gauss rule (``None``: scikit-fem's
+    default) and whether it condenses a P0 pressure (Q1P0, H1P0)."""
+    name: str
+    mesh: type
+    element: type
+    intorder: int = None
+    mean_dilatation: bool = False
+
+
+_FE = {}
+
+
+def register_fe(name, mesh, element, intorder=None, mean_dilatation=False):
+    """Register an FE comparator (see :class:`FEMethod`); returns it."""
+    record = FEMethod(name, mesh, element, intorder, bool(mean_dilatation))
+    _FE[name] = record
+    return record
+
+
+def fe_method(name):
+    """The :class:`FEMethod` of ``name``; ``ValueError`` naming the
+    registered ones if there is none."""
+    try:
+        return _FE[name]
+    except KeyError:
+        raise ValueError("unknown FE method {!r}: one of {}".format(
+            name, ", ".join(_FE))) from None
+
+
+def unregister_fe(name):
+    """Remove an FE comparator (a user's; tests)."""
+    _FE.pop(name, None)
+
+
+def fe_names():
+    """The registered FE comparators, in registration order."""
+    return tuple(_FE)
+
+
+# Gauss rules: 2 and 3 points per direction for the multilinear and
+# multiquadratic elements (scikit-fem's defaults use 3 and 7); one point
+# for T1/O1, whose F is constant per element (exact; the default rule took
+# 4x the points); T2/O2: scikit-fem's defaults
+for _name, _mesh, _element, _order, _p0 in (
+        ("T1", fem.MeshTri1, fem.ElementTriP1, 1, False),
+        ("Q1", fem.MeshQuad1, fem.ElementQuad1, 2, False),
+        ("O1", fem.MeshTet1, fem.ElementTetP1, 1, False),
+        ("H1", fem.MeshHex1, fem.ElementHex1, 2, False),
+        ("Q1P0", fem.MeshQuad1, fem.ElementQuad1, 2, True),
+        ("H1P0", fem.MeshHex1, fem.ElementHex1, 2, True),
+        ("T2", fem.MeshTri1, fem.ElementTriP2, None, False),
+        ("Q2", fem.MeshQuad1, fem.ElementQuad2, 4, False),
+        ("O2", fem.MeshTet1, fem.ElementTetP2, None, False),
+        ("H2", fem.MeshHex1, fem.ElementHex2, 4, False)):
+    register_fe(_name, _mesh, _element, _order, _p0)

@@ -243,3 +243,31 @@ def test_a_registered_builder_must_return_a_model():
             model_for("NotAModel", basis, NeoHooke(1.0, 1.0))
     finally:
         pg.registry.unregister("NotAModel")
+
+
+def test_an_fe_comparator_of_ones_own_is_one_registration():
+    """The FE comparators live in the same registry: a registered one is
+    a method name of Scene.solve (here Q1 with a 3 x 3 Gauss rule: exact
+    to degree 4)."""
+    import numpy as np
+    import skfem as fem
+    from skfem_pg.materials import NeoHooke
+    from skfem_pg.scenes import Scene
+    pg.registry.register_fe("Q1G3", fem.MeshQuad1, fem.ElementQuad1,
+                            intorder=4)
+    try:
+        mesh = fem.MeshQuad.init_tensor(
+            np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
+            {"left": lambda x: np.isclose(x[0], 0),
+             "right": lambda x: np.isclose(x[0], 4)})
+        sc = Scene("own-fe", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+                   tractions={"right": [0.0, 0.1]},
+                   probes={"tip": (4.0, 1.0)})
+        g3, q1 = sc.solve("FEM Q1G3"), sc.solve("Q1")
+        assert g3.basis.X.shape[1] == 9 and q1.basis.X.shape[1] == 4
+        assert np.abs(g3.u - q1.u).max() <= 0.05 * np.abs(q1.u).max()
+        assert fe_method("FEM Q1G3") == "Q1G3"
+    finally:
+        pg.registry.unregister_fe("Q1G3")
+    with pytest.raises(ValueError, match="unknown FE comparator"):
+        fe_method("FEM Q1G3")

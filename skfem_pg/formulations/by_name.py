@@ -35,7 +35,6 @@ from .nodal import NodalPressure
 from .protocol import check_model
 from .stabilized import U1SIG, U1SUnl
 from .. import registry
-from ..naming import FE_NAMES
 
 
 def _incompressible(material):
@@ -106,8 +105,8 @@ def model_for(formulation, basis, material, tangent="consistent"):
     with ``material``.  An unknown token, or a family basis whose shape
     functions are not the token's (``U2``, ``U2P1``, ``U2P1C`` need
     WTE2), raises ``ValueError`` naming it."""
-    if formulation in FE_NAMES:
-        if formulation in ("Q1P0", "H1P0"):
+    if formulation in registry.fe_names():
+        if registry.fe_method(formulation).mean_dilatation:
             cls = IncompressibleP0 if _incompressible(material) \
                 else MeanDilatation
             return cls.of(basis, material)
@@ -116,7 +115,7 @@ def model_for(formulation, basis, material, tangent="consistent"):
         record = registry.formulation(formulation)
     except ValueError as err:
         raise ValueError("{}; FE methods {}".format(
-            err, ", ".join(FE_NAMES))) from None
+            err, ", ".join(registry.fe_names()))) from None
     shape = getattr(basis, "shape", None)
     if isinstance(shape, str) and record.shape == "WTE2" and shape != "WTE2":
         raise ValueError(

@@ -22,7 +22,8 @@ import skfem as fem
 
 from ..formulations.linear import linear_elasticity
 from .meshing import cook_membrane
-from .scene import FE_METHODS, centroid_tree, inside
+from .. import registry
+from .scene import centroid_tree, inside
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
@@ -114,8 +115,8 @@ class Reference:
     def __init__(self, mesh, method, u, probes):
         self.mesh, self.method, self.u = mesh, method, u
         self.probes = probes
-        _, E = FE_METHODS[method]
-        self.basis = fem.Basis(mesh, fem.ElementVector(E()))
+        self.basis = fem.Basis(mesh, fem.ElementVector(
+            registry.fe_method(method).element()))
         self._finder = mesh.element_finder()
         self._tree = centroid_tree(mesh)
 

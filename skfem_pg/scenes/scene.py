@@ -51,27 +51,13 @@ from ..solvers.result import Result
 from .. import distributed, registry
 from ..distributed.solve import DistributedResult
 
-#: method -> (mesh class needed, scalar element)
-FE_METHODS = {
-    "T1": (fem.MeshTri1, fem.ElementTriP1),
-    "T2": (fem.MeshTri1, fem.ElementTriP2),
-    "Q1": (fem.MeshQuad1, fem.ElementQuad1),
-    "Q1P0": (fem.MeshQuad1, fem.ElementQuad1),
-    "Q2": (fem.MeshQuad1, fem.ElementQuad2),
-    "O1": (fem.MeshTet1, fem.ElementTetP1),
-    "O2": (fem.MeshTet1, fem.ElementTetP2),
-    "H1": (fem.MeshHex1, fem.ElementHex1),
-    "H1P0": (fem.MeshHex1, fem.ElementHex1),
-    "H2": (fem.MeshHex1, fem.ElementHex2),
-}
-
-
-#: Gauss rules: 2 and 3 points per direction for the multilinear and
-#: multiquadratic elements (scikit-fem's defaults use 3 and 7); one point
-#: for T1/O1, whose F is constant per element (exact; the default rule
-#: took 4x the points); T2/O2: scikit-fem's defaults
-INTORDER = {"T1": 1, "O1": 1, "Q1": 2, "Q1P0": 2, "H1": 2, "H1P0": 2,
-            "Q2": 4, "H2": 4}
+#: method -> (mesh class needed, scalar element) of the FE comparators
+#: (derived from :mod:`skfem_pg.registry`, where they are registered)
+FE_METHODS = {n: (registry.fe_method(n).mesh, registry.fe_method(n).element)
+              for n in registry.fe_names()}
+#: their Gauss rules (:mod:`skfem_pg.registry`; T2/O2: scikit-fem's)
+INTORDER = {n: registry.fe_method(n).intorder for n in registry.fe_names()
+            if registry.fe_method(n).intorder is not None}
 
 
 class Scene:
@@ -207,7 +193,7 @@ class Scene:
         """The mesh a FE method runs on (triangles from quads, tets from
         hexes by splitting: the same nodes)."""
         mesh = self.mesh if mesh is None else mesh
-        need, _ = FE_METHODS[method]
+        need = registry.fe_method(method).mesh
         if isinstance(mesh, need):
             return mesh
         if need is fem.MeshTri1 and isinstance(mesh, fem.MeshQuad1):
@@ -365,22 +351,22 @@ class Scene:
                 model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
-        elif method in FE_METHODS:
+        elif method in registry.fe_names():
             if basis_kwargs:
                 raise ValueError(
                     "{} is a scikit-fem element: the family basis options "
                     "{} do not apply to it".format(
                         method, ", ".join(sorted(basis_kwargs))))
             mesh = self.fe_mesh(method, mesh)
-            _, E = FE_METHODS[method]
-            basis = fem.Basis(mesh, fem.ElementVector(E()),
-                              intorder=INTORDER.get(method))
+            fe = registry.fe_method(method)
+            basis = fem.Basis(mesh, fem.ElementVector(fe.element()),
+                              intorder=fe.intorder)
             model = model_for(method, basis, self.material)
             f = sum((self._fe_traction(basis, mesh, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         else:
             raise ValueError("unknown method {!r}: 'PG' or one of {}".format(
-                method, ", ".join(FE_METHODS)))
+                method, ", ".join(registry.fe_names())))
         D, u_D = self._dirichlet(basis)
         return basis, model, f, D, u_D, time.perf_counter() - t0
 
@@ -412,14 +398,15 @@ def _scheme(scheme, basis_kwargs):
     ``"PG"`` and thesis names, whose basis options are merged under the
     given ``basis_kwargs``)."""
     method = fe_method(scheme) or scheme
-    if method in FE_METHODS or method == "PG":
+    if method in registry.fe_names() or method == "PG":
         return method, "Unl", basis_kwargs
     try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
         kw, _ = parse(method)
     except ValueError as err:
         raise ValueError("unknown method {!r}: 'PG', a thesis name (e.g. "
                          "'VCPBG Unl') or one of {} ({})".format(
-                             method, ", ".join(FE_METHODS), err)) from None
+                             method, ", ".join(registry.fe_names()),
+                             err)) from None
     return "PG", formulation_of(method), {**kw, **basis_kwargs}
 
 
