@@ -29,6 +29,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .assembly import batched_view, assemble_local
+from .layout import is_family_basis
 
 
 class Elements:
@@ -42,7 +43,7 @@ class Elements:
             raise TypeError("per-element reductions need a FamilyBasis or a "
                             "scikit-fem cell basis, got {}".format(
                                 type(basis).__name__))
-        self.family = hasattr(basis, "layout")
+        self.family = is_family_basis(basis)
         self.n = (basis.layout.n_families if self.family
                   else basis.dx.shape[0])
         self.point_shape = ((1, basis.layout.n_points) if self.family

@@ -136,3 +136,11 @@ class SizeGroups:
                 ).format(
             self.n_families, len(self), self.groups[0].m, self.m_max,
             self.n_points)
+
+
+def is_family_basis(basis):
+    """Whether ``basis`` is a family basis (a
+    :class:`~skfem_pg.FamilyBasis`: particles, families and their layout)
+    rather than a scikit-fem cell basis — the one test the formulations,
+    solvers and output use to tell PG from FE."""
+    return hasattr(basis, "layout") and hasattr(basis, "particles")

@@ -34,6 +34,8 @@ import warnings
 import numpy as np
 import skfem as fem
 
+from .layout import is_family_basis
+
 
 def call_user(f, x, what, *args):
     """``f(x, *args)`` of a user's callable as a float array.  ``x`` goes
@@ -159,7 +161,7 @@ def _area_correction(basis, facets):
 def body_force(basis, b, rho=1.0):
     r"""Nodal forces :math:`\rho_0 b(X^i) V^i` of a body force ``b``
     (constant vector or callable of positions ``(dim, n)``)."""
-    if not hasattr(basis, "particles"):
+    if not is_family_basis(basis):
         raise TypeError(
             "body_force lumps b V^i on particles; for a scikit-fem basis "
             "assemble the consistent load instead, e.g. "

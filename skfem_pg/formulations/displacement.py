@@ -38,6 +38,7 @@ from ..materials.hyperelastic import det
 from ..threads import kernel
 from .history import History
 from .tangents import fd_tangent
+from ..discretization.layout import is_family_basis
 
 
 @fem.LinearForm
@@ -70,7 +71,7 @@ material_tangent.coefficients = _tangent_coefficients
 
 
 def _dim(basis):
-    return basis.particles.dim if hasattr(basis, "particles") else \
+    return basis.particles.dim if is_family_basis(basis) else \
         basis.mesh.dim()
 
 
@@ -89,7 +90,7 @@ class Hyperelastic:
     def __init__(self, basis, material, tangent="consistent"):
         if tangent not in ("consistent", "fd"):
             raise ValueError("tangent must be 'consistent' or 'fd'")
-        if tangent == "fd" and not hasattr(basis, "G"):
+        if tangent == "fd" and not is_family_basis(basis):
             raise ValueError("the finite-difference tangent is built from "
                              "family forces: it needs a FamilyBasis")
         if not np.isfinite(getattr(material, "K", 0.0)):
@@ -176,14 +177,14 @@ class Hyperelastic:
         the unpadded flat layout ``(d, d, 1, N_q)``
         (:mod:`skfem_pg.discretization.layout`),
         so the material is evaluated only at real members."""
-        if hasattr(self.basis, "layout"):
+        if is_family_basis(self.basis):
             return {"F": self.basis.interpolate(u, flat=True).grad
                     + self._eye}
         return {"F": self.basis.interpolate(u).grad + self._eye}
 
     def energy(self, state):
         """Stored energy :math:`\\sum w\\, W(F)` of ``state``."""
-        dx = (self.basis.flat_weights() if hasattr(self.basis, "layout")
+        dx = (self.basis.flat_weights() if is_family_basis(self.basis)
               else self.basis.dx)
         return float(np.sum(dx * self.material.energy(state["F"])))
 

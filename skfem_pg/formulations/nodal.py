@@ -51,6 +51,7 @@ from ..materials import NeoHookeIsoVol, ReturnMapError, inverse_and_det
 from ..threads import kernel
 from .dilatation import d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, internal_force, material_tangent
+from ..discretization.layout import is_family_basis
 
 #: local Newton of the bubble: largest iterations, and the tolerance on
 #: the change of F
@@ -91,11 +92,11 @@ class NodalPressure(Hyperelastic):
     """
 
     def __init__(self, basis, mu, K, bubble=True):
-        if not hasattr(basis, "layout") or getattr(basis, "is_petrov",
-                                                    False):
+        if not is_family_basis(basis) or getattr(basis, "is_petrov",
+                                                  False):
             raise NotImplementedError(
                 "U2P1C and Unl+P1C are built on PBG family bases (got {})"
-                .format(type(basis).__name__ if not hasattr(basis, "layout")
+                .format(type(basis).__name__ if not is_family_basis(basis)
                         else "a Petrov–Galerkin basis"))
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked

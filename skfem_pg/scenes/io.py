@@ -5,6 +5,8 @@ import os
 import numpy as np
 import meshio
 
+from ..discretization.layout import is_family_basis
+
 
 def write_vtu(filename, particles, **point_data):
     """Write particles and their fields for ParaView.
@@ -69,7 +71,7 @@ def step_writer(basis, **fields):
     (:func:`write_vtu`); on a scikit-fem basis its mesh, with dof vectors
     (length ``basis.N``) and per-vertex arrays as point data and
     per-element arrays as cell data."""
-    if hasattr(basis, "particles"):
+    if is_family_basis(basis):
         return lambda fn: write_vtu(fn, basis.particles, **fields)
 
     def write(fn):

@@ -24,6 +24,7 @@ import zipfile
 
 import numpy as np
 from ..naming import name_of
+from ..discretization.layout import is_family_basis
 
 #: bump when the stored content changes meaning
 FORMAT = 2
@@ -61,7 +62,7 @@ def fingerprint(model):
     basis = model.basis
     material = getattr(model, "material", None)
     material = getattr(material, "material", material)  # a History's law
-    if hasattr(basis, "layout"):
+    if is_family_basis(basis):
         try:
             kind = name_of(basis)
         except (KeyError, ValueError):

@@ -17,6 +17,8 @@ import numpy as np
 import skfem as fem
 from skfem.helpers import dot
 
+from ..discretization.layout import is_family_basis
+
 
 @fem.BilinearForm
 def _mass_form(u, v, w):
@@ -34,7 +36,7 @@ def lumped_mass(basis, rho):
     consistent mass.  Raises ``ValueError`` for a non-positive density and,
     naming the dof and its location, for a non-positive lumped entry
     (quadratic elements; a particle without volume)."""
-    if hasattr(basis, "particles"):
+    if is_family_basis(basis):
         p = basis.particles
         d = p.dim
         rho = _per(rho, p.n, "particle")

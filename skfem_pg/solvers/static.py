@@ -21,6 +21,7 @@ from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
 from .linear import linear_solver, submatrix
+from ..discretization.layout import is_family_basis
 
 
 class ConvergenceError(RuntimeError):
@@ -55,7 +56,7 @@ def condensed_solver(kind, basis, I, extra_fields=False):
     # dof j is component j % d of its node, also for a subset of them
     return linear_solver(kind, None if locs is None else locs[:, I],
                          symmetric=getattr(basis, "test", None) is None,
-                         candidates=PG_CANDIDATES if hasattr(basis, "layout")
+                         candidates=PG_CANDIDATES if is_family_basis(basis)
                          else 0,
                          components=None if locs is None
                          else I % locs.shape[0])
