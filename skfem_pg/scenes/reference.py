@@ -52,10 +52,14 @@ def _checksum(arrays):
     return h.hexdigest()
 
 
-def _load(fn, mesh_type, method, probes):
-    """The stored :class:`Reference`; ``ValueError`` naming what does not
-    fit: format, checksum (an edited file), the solution's length for
-    ``method`` on the stored mesh, the probe names."""
+#: what an unreadable cache entry raises (then it is recomputed)
+UNREADABLE = (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile)
+
+
+def _read(fn):
+    """The arrays of the cache entry ``fn`` (written by :func:`_store`);
+    ``ValueError`` if its format or checksum (an edited file) does not
+    fit."""
     with np.load(fn) as data:
         arrays = {k: data[k] for k in data.files}
     fmt = arrays.pop("format", None)
@@ -65,6 +69,14 @@ def _load(fn, mesh_type, method, probes):
     stored = str(arrays.pop("checksum", ""))
     if stored != _checksum(arrays):
         raise ValueError("its checksum does not match its content")
+    return arrays
+
+
+def _load(fn, mesh_type, method, probes):
+    """The stored :class:`Reference`; ``ValueError`` naming what does not
+    fit: format, checksum, the solution's length for ``method`` on the
+    stored mesh, the probe names."""
+    arrays = _read(fn)
     got = {k[6:]: v for k, v in arrays.items() if k.startswith("probe_")}
     if sorted(got) != sorted(probes):
         raise ValueError("probes {} where the scene has {}".format(
@@ -172,8 +184,7 @@ def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
     if os.path.exists(fn):
         try:
             return _load(fn, type(scene.mesh), method, scene.probes)
-        except (OSError, ValueError, KeyError, EOFError,
-                zipfile.BadZipFile) as err:
+        except UNREADABLE as err:
             warnings.warn("the cached overkill reference {} is unreadable "
                           "({}: {}); recomputing it".format(
                               fn, type(err).__name__, err))
@@ -202,19 +213,14 @@ def linear_cook(lam, mu, sizes=(64, 128), point=(48.0, 52.0),
     fn = os.path.join(cache_dir(), "linear-cook-{}.npz".format(key))
     if os.path.exists(fn):
         try:
-            with np.load(fn) as data:
-                arrays = {k: data[k] for k in data.files}
-            stored = str(arrays.pop("checksum", ""))
-            fmt = arrays.pop("format", None)
-            if (fmt is not None and int(fmt) == CACHE_FORMAT
-                    and stored == _checksum(arrays)
-                    and np.array_equal(arrays["args"], args)):
-                return float(arrays["v"]), tuple(arrays["q2"])
-            warnings.warn("the reference cache {} does not match its key or "
-                          "content; recomputing".format(fn))
-        except (OSError, ValueError, KeyError, zipfile.BadZipFile) as err:
-            warnings.warn("the reference cache {} is unreadable ({}); "
-                          "recomputing".format(fn, err))
+            arrays = _read(fn)
+            if not np.array_equal(arrays["args"], args):
+                raise ValueError("its key is another problem's")
+            return float(arrays["v"]), tuple(arrays["q2"])
+        except UNREADABLE as err:
+            warnings.warn("the reference cache {} is unreadable ({}: {}); "
+                          "recomputing it".format(fn, type(err).__name__,
+                                                  err))
     form = linear_elasticity(lam, mu)
     vals = []
     for n in sizes:
