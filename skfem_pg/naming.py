@@ -127,10 +127,8 @@ def parse(name):
     if g["bc"] and not first_order:
         raise ValueError("{!r}: the bond correction is for first-order "
                          "formulations ({}), not {}".format(
-                             name, ", ".join(
-                                 t for t in registry.tokens()
-                                 if registry.formulation(t).first_order),
-                             form))
+                             name, ", ".join(registry.tokens(
+                                 first_order=True)), form))
     if g["bc"] and record.master_only:
         raise ValueError("{!r}: {} evaluates its gradient at the master "
                          "only, where the bond correction has no bond; "

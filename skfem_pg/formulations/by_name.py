@@ -83,20 +83,17 @@ def _stabilized(cls):
 for _token, _shape in (("U1", "WTE1"), ("Unl", "MTE1"), ("U2", "WTE2")):
     registry.register(_token, _shape, _displacement,
                       updated_lagrangian=True,
-                      distributed=_shape != "WTE2", replace=True)
+                      distributed=_shape != "WTE2")
 registry.register("UnlP0", "MTE1", _mean_dilatation("UnlP0", False),
-                  kind="mixed", replace=True)
+                  kind="mixed")
 registry.register("IUnlP0", "MTE1", _mean_dilatation("IUnlP0", True),
-                  kind="mixed", replace=True)
-registry.register("Unl+P1C", "MTE1", _nodal(True), kind="mixed",
-                  replace=True)
-registry.register("U2P1", "WTE2", _u2p1, kind="mixed", replace=True)
-registry.register("U2P1C", "WTE2", _nodal(False), kind="mixed",
-                  replace=True)
-registry.register("U1SUnl", "MTE1", _stabilized(U1SUnl), kind="stabilized",
-                  replace=True)
+                  kind="mixed")
+registry.register("Unl+P1C", "MTE1", _nodal(True), kind="mixed")
+registry.register("U2P1", "WTE2", _u2p1, kind="mixed")
+registry.register("U2P1C", "WTE2", _nodal(False), kind="mixed")
+registry.register("U1SUnl", "MTE1", _stabilized(U1SUnl), kind="stabilized")
 registry.register("U1SIG", "WTE1", _stabilized(U1SIG), kind="stabilized",
-                  master_only=True, replace=True)
+                  master_only=True)
 
 
 def model_for(formulation, basis, material, tangent="consistent"):

@@ -2,7 +2,7 @@
 FE overkill references (``reference``), node sets from the ``.geo``
 sources of the repository's ``meshes/`` (``meshing``), VTU output
 (``io``) and result pages (``reporting``)."""
-from .scene import Scene, Result, FE_METHODS, INTORDER, inside, centroid_tree
+from .scene import Scene, Result, inside, centroid_tree
 
-__all__ = ["Scene", "Result", "FE_METHODS", "INTORDER", "inside",
+__all__ = ["Scene", "Result", "inside",
            "centroid_tree"]

@@ -51,14 +51,6 @@ from ..solvers.result import Result
 from .. import distributed, registry
 from ..distributed.solve import DistributedResult
 
-#: method -> (mesh class needed, scalar element) of the FE comparators
-#: (derived from :mod:`skfem_pg.registry`, where they are registered)
-FE_METHODS = {n: (registry.fe_method(n).mesh, registry.fe_method(n).element)
-              for n in registry.fe_names()}
-#: their Gauss rules (:mod:`skfem_pg.registry`; T2/O2: scikit-fem's)
-INTORDER = {n: registry.fe_method(n).intorder for n in registry.fe_names()
-            if registry.fe_method(n).intorder is not None}
-
 
 class Scene:
     """A nonlinear solid-mechanics problem on a node set.
@@ -267,7 +259,8 @@ class Scene:
         IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
         basis options), ``"PG"`` (the displacement formulation;
         ``basis_kwargs`` go to ``FamilyBasis``, e.g. ``method="PPG1"``) or
-        an FE method of :data:`FE_METHODS` (also as ``"FEM Q1P0"``);
+        an FE comparator of :func:`skfem_pg.registry.fe_names` (also as
+        ``"FEM Q1P0"``);
         ``tol``: Newton's relative residual tolerance
         (:func:`~skfem_pg.solvers.newton`).  Returns a :class:`Result`.
 
@@ -394,7 +387,7 @@ class Scene:
 
 def _scheme(scheme, basis_kwargs):
     """``(method, formulation, basis_kwargs)`` of a scene method name:
-    ``method`` is the FE method of :data:`FE_METHODS` or ``"PG"`` (for
+    ``method`` is an FE comparator (:mod:`skfem_pg.registry`) or ``"PG"`` (for
     ``"PG"`` and thesis names, whose basis options are merged under the
     given ``basis_kwargs``)."""
     method = fe_method(scheme) or scheme
