@@ -62,20 +62,25 @@ def _bilinear_map(xi, eta, corners):
             + xi * eta * c[2][:, None] + (1 - xi) * eta * c[3][:, None])
 
 
-def vertex_at(mesh, point, tol=1e-9):
-    """The index of the vertex of ``mesh`` at ``point`` (within ``tol``
-    times the mesh's extent); ``ValueError`` naming the point and the
-    nearest vertex if there is none."""
+def point_index(points, point, what="vertex", tol=1e-9):
+    """The index of the column of ``points`` ``(d, n)`` at ``point``
+    (within ``tol`` times ``max(1, |point|)``); ``ValueError`` naming the
+    point and the nearest ``what`` if there is none."""
     point = np.asarray(point, dtype=float)
-    dist = np.linalg.norm(mesh.p - point[:, None], axis=0)
+    dist = np.linalg.norm(points - point[:, None], axis=0)
     k = int(np.argmin(dist))
-    extent = np.ptp(mesh.p, axis=1).max()
-    if dist[k] > tol * extent:
-        raise ValueError("no vertex at {}: the nearest, {}, is at {} "
-                         "(distance {:.3g})".format(
-                             tuple(point.tolist()), k,
-                             tuple(mesh.p[:, k].tolist()), dist[k]))
+    if dist[k] > tol * max(1.0, np.abs(point).max()):
+        raise ValueError("no {} at {}: the nearest, {}, is at {} (distance "
+                         "{:.3g})".format(what, tuple(point.tolist()), k,
+                                          tuple(points[:, k].tolist()),
+                                          dist[k]))
     return k
+
+
+def vertex_at(mesh, point):
+    """The index of the vertex of ``mesh`` at ``point``
+    (:func:`point_index`)."""
+    return point_index(mesh.p, point)
 
 
 def cook_membrane(n, kind="quad"):

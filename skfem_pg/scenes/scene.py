@@ -50,6 +50,7 @@ from ..solvers import newton
 from ..solvers.result import Result
 from .. import distributed, registry
 from ..distributed.solve import DistributedResult
+from .meshing import point_index
 
 
 class Scene:
@@ -372,12 +373,11 @@ class Scene:
             particles = basis.particles
         for label, x in self.probes.items():
             if particles is not None:
-                p = particles
-                i = int(np.argmin(np.linalg.norm(p.x - x[:, None], axis=0)))
-                if np.linalg.norm(p.x[:, i] - x) > 1e-9 * max(1.0, np.abs(
-                        x).max()):
-                    raise ValueError("probe {} at {} is not a particle"
-                                     .format(label, tuple(x)))
+                try:
+                    i = point_index(particles.x, x, "particle")
+                except ValueError as err:
+                    raise ValueError("probe {} at {} is not a particle ({})"
+                                     .format(label, tuple(x), err)) from None
                 out[label] = u.reshape(-1, d)[i].copy()
             else:
                 xi = inside(basis.mesh, x[:, None])
