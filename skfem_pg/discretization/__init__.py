@@ -16,18 +16,22 @@ systems.
                        ``vc_boundary``, ``vc2``: boundary variants, VC2
 ``petrov``             PPG test bases (4.21), (4.22)
 ``layout``             families grouped by size (unpadded hot paths)
-``basis``              :class:`FamilyBasis`
+``builder``            :class:`BasisSpec` (every option, resolved) and the
+                       stages one builder composes into a basis
+``basis``              :class:`FamilyBasis`, the container of the built
+                       arrays behind scikit-fem's basis interface
 ``assembly``, ``forms``  batched assembly; the fast-path decorators
 ``loads``              tractions, stress and body loads on FE and PG bases
 =====================  ====================================================
 """
 from .particles import Particles
 from .families import Families
+from .builder import BasisSpec
 from .basis import FamilyBasis
 from .assembly import assemble, block_pattern
 from .forms import BilinearForm, LinearForm
 from .loads import traction, stress_load, body_force
 
-__all__ = ["Particles", "Families", "FamilyBasis", "assemble",
+__all__ = ["Particles", "Families", "BasisSpec", "FamilyBasis", "assemble",
            "block_pattern", "BilinearForm", "LinearForm", "traction",
            "stress_load", "body_force"]

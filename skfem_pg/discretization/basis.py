@@ -35,7 +35,6 @@ assembly; the batched hot paths (:func:`skfem_pg.assemble`,
 """
 import copy
 import sys
-import time
 import warnings
 
 import numpy as np
@@ -43,31 +42,19 @@ import skfem as fem
 from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
-from . import families as families_mod
+from . import builder
 from . import petrov
-from . import recipes
-from .corrections import (bond_correction, check_correction,
-                          correction_functions, family_radii, vc_correction)
+from .builder import TEST_GRADIENTS, BasisSpec
+from .corrections import family_radii
 from ..dofs import as_dofs
-from ..errors import FamilyError, SlowAssemblyWarning, describe_particle
+from ..errors import SlowAssemblyWarning
 from .particles import Particles, linear_elements
-from .quadrature import volume_weights, weight_rule
-from .shape import GRADIENTS
+from .quadrature import volume_weights
 from ..threads import kernel
-from .shape.least_squares import (mls1_master_gradients,
-                                   wls1_master_gradients,
-                                   wls2_master_gradients)
-from .shape.lme import lme_master_gradients
-from .vc2 import vc2_correction
-from ..naming import name_of, parse
+from ..naming import name_of
 
-METHODS = ("PBG", "PPG1", "PPG2")
-#: test derivatives of PPG at the masters
-#: least-squares PPG test derivatives at the masters
-LS_TEST_GRADIENTS = {"WLS1": wls1_master_gradients,
-                     "WLS2": wls2_master_gradients,
-                     "MLS1": mls1_master_gradients}
-TEST_SHAPES = ("master", "WTE1", "WLS1", "WLS2", "MLS1", "LME")
+#: PPG test derivatives at the masters (``test_shape``)
+TEST_SHAPES = tuple(TEST_GRADIENTS)
 
 
 #: PBG quadrature weights :math:`w_{kj} = V^k V^j / V_H^k` (4.30), the
@@ -217,219 +204,51 @@ class FamilyBasis(AbstractBasis):
                  vc_solver="auto", area_vectors=None, vc_exclude=None,
                  test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
                  vc_tolerance=1e-8, distributed=None, weights="auto"):
-        if isinstance(particles, fem.Mesh):
-            particles = Particles.from_mesh(particles)
-        if not isinstance(particles, Particles):
-            raise TypeError("particles must be a skfem_pg.Particles or a "
-                            "scikit-fem mesh, got {}"
-                            .format(type(particles).__name__))
-        if dim is not None and (isinstance(dim, bool) or dim
-                                != particles.dim):
-            raise ValueError(
-                "dim={!r} components on {}-D particles: a vector field "
-                "(displacements) has dim={}, a scalar field dim=None"
-                .format(dim, particles.dim, particles.dim))
-        if method not in METHODS:
-            raise NotImplementedError(
-                "method {!r} is not available; this version implements {}"
-                .format(method, ", ".join(METHODS)))
-        if shape not in GRADIENTS:
-            raise ValueError("unknown shape functions {!r}; available: {}"
-                             .format(shape, ", ".join(GRADIENTS)))
-        ppg = method != "PBG"
-        if bond is None:  # PPG too: without it VC PPG1 is unstable
-            bond = shape == "MTE1"
-        if bond and shape == "WTE2":
-            raise ValueError("the bond correction (5.55) is for linear "
-                             "bases; use bond=False with shape='WTE2'")
-        if vc == "auto":
-            vc = {"MTE1": "V5" if bond and not ppg else "V3",
-                  "WTE2": "V3"}.get(shape)
-        if vc == "VC2" and (shape != "WTE2" or method == "PPG2"):
-            raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
-                             "trial basis: shape='WTE2', method='PBG' or "
-                             "'PPG1'")
-        if test_shape not in TEST_SHAPES:
-            raise ValueError("test_shape must be one of {}, got {!r}".format(
-                ", ".join(TEST_SHAPES), test_shape))
-        if test_shape != "master" and not ppg:
-            raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
-                             "use method='PPG1' or 'PPG2'".format(test_shape))
-        allowed = (("V1", "V2", "V3", "V4", "VC2") if ppg
-                   else ("V2", "V3", "V4", "V5", "VC2"))
-        if vc is not None and vc not in allowed:
-            raise ValueError("vc={!r} is not available for {}: use one of {} "
-                             "or None".format(vc, method, ", ".join(allowed)))
-        if vc == "V5" and not bond:
-            raise ValueError("vc='V5' keeps the bond mapping and needs "
-                             "bond=True; use vc='V3' without bond correction")
-        if vc_boundary != "min-norm" and (
-                vc is None or method == "PPG2"
-                or (vc == "VC2" and vc_boundary != "s")):
-            raise NotImplementedError(
-                "vc_boundary={!r} is implemented for the first-order VC of "
-                "PBG and PPG1 (vc V1, V3, V4, V5) and, 's' only, for VC2; "
-                "not for {} vc={}".format(vc_boundary, method, vc))
-        if vc is not None and area_vectors is None and particles.mesh is None:
-            raise ValueError(
-                "the VC correction needs surface area vectors A^i: these "
-                "particles have no mesh, so pass area_vectors= (shape "
-                "(dim, n)) or use vc=None")
-        if ppg and weights not in ("auto", None, "volume"):
-            raise ValueError("weights={!r} is a PBG option: PPG integrates "
-                             "with the member volumes V^j".format(weights))
-        t_families = time.perf_counter()
-        if families is None and shape == "WTE2":
-            # twice the d + d(d+1)/2 quadratic moments, plus the master:
-            # with fewer, corner families of graded meshes (Cook's (48,
-            # 60) at 7 members) give a singular WTE2 moment matrix
-            d = particles.dim
-            families = families_mod.horizon(
-                particles, factor=2.51,
-                min_size=1 + 2 * (d + d * (d + 1) // 2))
-        elif families is None and particles.mesh is None:
-            families = "horizon"
-        families, weights, weight_exponent, self.recipe = recipes.resolve(
-            particles, families, weights, weight_exponent, method, shape)
-        weight_exponent = recipes.check_exponent(weight_exponent)
-        self._weigh = weight_rule(weights)
-        self.particles = particles
-        self.shape, self.bond, self.vc, self.method = shape, bond, vc, method
-        self.weights = weights
-        # what rebuilds this basis on moved particles (updated Lagrange):
-        # the family rule, not the families
-        self.options = dict(
-            shape=shape, bond=bond, vc=vc, method=method, dim=dim,
-            weight_exponent=weight_exponent, vc_solver=vc_solver,
-            vc_exclude=vc_exclude, test_shape=test_shape, lme_mu=lme_mu,
-            vc_boundary=vc_boundary, vc_tolerance=vc_tolerance,
-            weights=weights)
-        if isinstance(families, str):
-            self.options["families"] = families
-        self.test_shape = test_shape
+        particles = _as_particles(particles)
+        spec = BasisSpec.resolve(
+            particles, families=families, shape=shape, bond=bond, vc=vc,
+            method=method, dim=dim, weight_exponent=weight_exponent,
+            vc_solver=vc_solver, vc_exclude=vc_exclude,
+            test_shape=test_shape, lme_mu=lme_mu, vc_boundary=vc_boundary,
+            vc_tolerance=vc_tolerance, weights=weights,
+            area_vectors=area_vectors)
+        self._hold(particles, spec, builder.build(
+            particles, spec, area_vectors=area_vectors,
+            distributed=distributed), distributed)
+
+    @classmethod
+    def from_spec(cls, particles, spec, area_vectors=None, distributed=None):
+        """The basis of a :class:`~skfem_pg.discretization.builder.BasisSpec`
+        (the keyword constructor resolves one and calls the same builder)."""
+        particles = _as_particles(particles)
+        basis = cls.__new__(cls)
+        basis._hold(particles, spec, builder.build(
+            particles, spec, area_vectors=area_vectors,
+            distributed=distributed), distributed)
+        return basis
+
+    def _hold(self, particles, spec, arrays, distributed):
+        """Keep the built arrays and set what scikit-fem's assembly reads."""
+        self.particles, self.spec = particles, spec
+        self.shape, self.bond, self.vc = spec.shape, spec.bond, spec.vc
+        self.method, self.weights = spec.method, spec.weights
+        self.weight_exponent, self.recipe = spec.weight_exponent, spec.recipe
+        self.test_shape, self.vc_boundary = spec.test_shape, spec.vc_boundary
+        #: what rebuilds this basis on moved particles (updated Lagrange)
+        self.options = spec.options()
         self.distributed = distributed
-        self._vc_correct = vc_correct = (
-            vc_correction if distributed is None
-            else distributed.vc_correction)
-        self.weight_exponent = weight_exponent
-        self.timings = {}
-        x, V = particles.x, particles.volumes
-        sdim = particles.dim
-
-        t0 = t_families
-        if isinstance(families, str):
-            families = families_mod.build(families, particles)
-        if ppg and distributed is None:  # a partition's come complete
-            families = petrov.pairwise(families)
-        self.families = families
-        self._check_families()
-        self.timings["families"] = time.perf_counter() - t0
-
-        self.vc_report = None
-        self.vc_boundary = vc_boundary
-        unpadded = (not ppg and shape in ("MTE1", "WTE1")
-                    and vc in (None, "V3", "V5") and vc_exclude is None
-                    and vc_boundary in ("min-norm", "p"))
-        self._G = self._G_groups = None
-        if distributed is not None and not unpadded and not (
-                method == "PPG1" and vc in (None, "V3")
-                and vc_boundary == "min-norm" and test_shape == "master"):
-            raise NotImplementedError(
-                "a distributed basis is PBG with MTE1/WTE1 and vc V3/V5 "
-                "or None, or PPG1 with vc V3 or None")
-        if unpadded:  # the default: each size group without padding
-            self._unpadded_pipeline(vc_solver, area_vectors, vc_tolerance)
-        else:
-            t0 = time.perf_counter()
-            G = GRADIENTS[shape](x, V, families, n=weight_exponent)
-            self.timings["gradients"] = time.perf_counter() - t0
-            if bond:
-                t0 = time.perf_counter()
-                G = bond_correction(G, x, families)
-                self.timings["bond"] = time.perf_counter() - t0
-
-            mem, mask = families.padded()
-            Vm = V[mem] * mask
-            if ppg:
-                self.dx = petrov.quadrature_weights(V, families)
-                Gt = np.zeros_like(G)  # test derivatives at the masters
-                Gt[:, 0] = G[:, 0]
-                if test_shape == "LME":
-                    g, ok = lme_master_gradients(x, families, mu=lme_mu)
-                    Gt[ok, 0] = g[ok]
-                elif test_shape in LS_TEST_GRADIENTS:
-                    Gt[:, 0] = LS_TEST_GRADIENTS[test_shape](
-                        x, V, families, n=weight_exponent)
-                elif test_shape == "WTE1":
-                    Gt[:, 0] = GRADIENTS["WTE1"](x, V, families,
-                                                 n=weight_exponent)[:, 0]
-                dx_t = np.zeros_like(Vm)
-                dx_t[:, 0] = V[families.masters]
-            else:
-                self.dx = self._weigh(V, families)
-            if vc is not None:
-                t0 = time.perf_counter()
-                area_vectors = self._area_vectors(area_vectors)
-                # VC2 of PPG1 corrects test functions only: V1 functions
-                # (the thesis' VC2PPG V1s U2); of PBG, V4 (keeps the trial's
-                # quadratic consistency)
-                surface = (particles.surface_area_vectors()
-                           if particles.mesh is not None else None)
-                phi = correction_functions("V1" if vc == "VC2" and ppg else vc,
-                                           x, V, families, n=weight_exponent)
-                if vc == "VC2" and ppg:
-                    warnings.warn(
-                        "VC2 PPG1 (VC2PPG V1 U2) passes the quadratic patch "
-                        "test but is unstable here: its free tangent has "
-                        "eigenvalues with negative real part (40 on a regular "
-                        "20x10 block, 214 distorted) and it does not converge "
-                        "on a manufactured solution; prefer PBG's VC2")
-                    Gt, self.vc_report = vc2_correction(
-                        Gt, dx_t, x, V, families, area_vectors,
-                        particles.area_moments(), phi, exclude=vc_exclude,
-                        boundary=vc_boundary, method="PPG1", surface=surface)
-                elif vc == "VC2":
-                    G, self.vc_report = vc2_correction(
-                        G, self.dx, x, V, families, area_vectors,
-                        particles.area_moments(), phi, exclude=vc_exclude,
-                        boundary=vc_boundary, surface=surface)
-                elif method == "PPG2":  # (5.17), its own sparse system
-                    warnings.warn(
-                        "VC PPG2 passes the patch test but is unstable here: "
-                        "its tangent has eigenvalues with negative real part "
-                        "(e.g. 4 on a regular 20x10 block) and it does not "
-                        "converge on a manufactured solution; prefer PPG1")
-                    Gm, self.vc_report = petrov.ppg2_vc_correction(
-                        Gt[:, 0], V, families, area_vectors, phi,
-                        exclude=vc_exclude)
-                    Gt[:, 0] = Gm
-                elif ppg:  # (5.16) is (5.18) with the master weights only
-                    Gt, self.vc_report = vc_correct(
-                        Gt, dx_t, x, V, families, area_vectors, phi,
-                        variant=vc, solver=vc_solver, exclude=vc_exclude,
-                        boundary=vc_boundary, surface=surface)
-                else:
-                    G, self.vc_report = vc_correction(
-                        G, self.dx, x, V, families, area_vectors, phi,
-                        variant=vc, solver=vc_solver, exclude=vc_exclude,
-                        boundary=vc_boundary, surface=surface)
-                self.timings["vc"] = time.perf_counter() - t0
-            what = ("{} {}".format(method, shape) if vc is None
-                    else "VC {} ({}{})".format(
-                        vc, method, "" if vc_boundary == "min-norm"
-                        else ", boundary " + vc_boundary))
-            check_correction(Gt if ppg else G, x, families, self.vc_report,
-                             vc_tolerance, what=what)
-            if ppg:  # the trial derivatives too
-                check_correction(G, x, families, None, what=shape + " trial")
-            self.G = G
+        self.families, self.dx = arrays.families, arrays.dx
+        self.timings, self.vc_report = arrays.timings, arrays.vc_report
+        self._G, self._G_groups = arrays.G, arrays.G_groups
         self.test = None
-        self.area_correction = (None if self.vc_report is None
-                                else self.vc_report.area_correction)
-        self.area2_correction = (None if self.vc_report is None
-                                 else self.vc_report.area2_correction)
+        report = self.vc_report
+        self.area_correction = None if report is None \
+            else report.area_correction
+        self.area2_correction = None if report is None \
+            else report.area2_correction
 
         # --- what scikit-fem's assembly reads ---------------------------
+        dim = spec.dim
         self.ncomp = dim
         nc = 1 if dim is None else int(dim)
         self.mesh = particles.mesh if particles.kind == "vertices" else None
@@ -441,24 +260,24 @@ class FamilyBasis(AbstractBasis):
             self.elem = None
             self.dofs = None
         self._N = nc * particles.n
-        self.doflocs = np.repeat(x, nc, axis=1)
-        mem = families.padded()[0]
-        nf, m = mem.shape
+        self.doflocs = np.repeat(particles.x, nc, axis=1)
+        nf, m = self.families.padded()[0].shape
         self.nelems = nf
         self.Nbfun = nc * m
         self.tind = None
         self._element_dofs = None  # padded; built when asked for
-        self.X = np.zeros((sdim, m))  # members play the quadrature points
+        self.X = np.zeros((particles.dim, m))  # members play the quad. points
         self.W = np.ones(m)
         self._basis = None
         self._pattern = None
         self.trial = None  # set on a PPG test basis: its trial basis
-        if ppg:
+        if spec.ppg:
+            Gm = arrays.test_master
             self.test = copy.copy(self)
             self.test.G = petrov.element_test_gradients(
-                Gt[:, 0], families, method, reverse=None
+                Gm, self.families, spec.method, reverse=None
                 if distributed is None else
-                distributed.reverse_master_derivatives(Gt[:, 0], families))
+                distributed.reverse_master_derivatives(Gm, self.families))
             self.test.trial = self
 
     @property
@@ -467,17 +286,16 @@ class FamilyBasis(AbstractBasis):
         return self.method != "PBG"
 
     @classmethod
-    def from_name(cls, particles, name, families=None, **kwargs):
+    def from_name(cls, particles, name, families=None, area_vectors=None,
+                  distributed=None, **kwargs):
         """A basis from a thesis name (Table 7.1), e.g.
         ``FamilyBasis.from_name(p, "VCBCPBG V5 Unl", dim=2)``; see
         :mod:`skfem_pg.naming`."""
-        kw, notes = parse(name)
-        if (isinstance(particles, Particles) and particles.mesh is None
-                and kw.get("families") == "mesh"):
-            kw["families"] = "horizon"  # the thesis' rule without a mesh
-        if families is not None:
-            kw["families"] = families
-        basis = cls(particles, **{**kw, **kwargs})
+        particles = _as_particles(particles)
+        spec, notes = BasisSpec.from_name(particles, name, families=families,
+                                          area_vectors=area_vectors, **kwargs)
+        basis = cls.from_spec(particles, spec, area_vectors=area_vectors,
+                              distributed=distributed)
         basis.name_notes = notes
         return basis
 
@@ -485,80 +303,6 @@ class FamilyBasis(AbstractBasis):
     def name(self):
         """Thesis name, e.g. ``"VCBCPBG V5 Unl"``."""
         return name_of(self)
-
-    # ------------------------------------------------------------------
-    def _area_vectors(self, area_vectors):
-        x = self.particles.x
-        if area_vectors is None:
-            area_vectors = self.particles.area_vectors()
-        area_vectors = np.asarray(area_vectors, dtype=float)
-        if area_vectors.shape != x.shape:
-            raise ValueError("area_vectors must have shape {}, got {}"
-                             .format(x.shape, area_vectors.shape))
-        return area_vectors
-
-    def _unpadded_pipeline(self, vc_solver, area_vectors, vc_tolerance):
-        """PBG with MTE1/WTE1 derivatives, bond and V3/V5 correction, one
-        size group at a time (:mod:`skfem_pg.discretization.layout`): work
-        and storage :math:`\\propto \\sum_k m_k^2` instead of
-        :math:`n_f m_{max}^2`; the kernels are the padded ones, run on each
-        group's own families."""
-        p, fam = self.particles, self.families
-        x, V, n = p.x, p.volumes, self.weight_exponent
-        L = fam.groups()
-        subs = [L.subset(g) for g in L]
-        t0 = time.perf_counter()
-        Gs = [GRADIENTS[self.shape](x, V, f, n=n) for f in subs]
-        self.timings["gradients"] = time.perf_counter() - t0
-        if self.bond:
-            t0 = time.perf_counter()
-            Gs = [bond_correction(G, x, f) for G, f in zip(Gs, subs)]
-            self.timings["bond"] = time.perf_counter() - t0
-        dxs = [self._weigh(V, f) for f in subs]
-        flat = np.empty(L.n_points)
-        for g, d in zip(L, dxs):
-            flat[g.flat] = d
-        self.dx = L.flat_to_padded(flat)
-        if self.vc is not None:
-            t0 = time.perf_counter()
-            area = self._area_vectors(area_vectors)
-            phis = [correction_functions(self.vc, x, V, f, n=n)
-                    for f in subs]
-            Gs, self.vc_report = self._vc_correct(
-                Gs, dxs, x, V, subs, area, phis, variant=self.vc,
-                solver=vc_solver, boundary=self.vc_boundary,
-                surface=(p.surface_area_vectors() if p.mesh is not None
-                         else None), index=[g.families for g in L])
-            self.timings["vc"] = time.perf_counter() - t0
-        what = ("PBG {}".format(self.shape) if self.vc is None
-                else "VC {} (PBG{})".format(
-                    self.vc, "" if self.vc_boundary == "min-norm"
-                    else ", boundary " + self.vc_boundary))
-        check_correction(Gs, x, subs, self.vc_report, vc_tolerance,
-                         what=what)
-        self._G_groups = Gs
-
-    def _check_families(self):
-        p, fam = self.particles, self.families
-        if fam.n_particles != p.n:
-            raise FamilyError("families refer to {} particles, the particle "
-                              "set has {}".format(fam.n_particles, p.n))
-        inactive = ~p.active[fam.members]
-        if np.any(inactive):
-            q = fam.members[np.nonzero(inactive)[0][0]]
-            raise FamilyError("{} has zero volume but is a family member"
-                              .format(describe_particle(q, p.x[:, q])))
-        # linear Taylor expansions need d others, WTE2 d + d(d+1)/2; MLS1
-        # at the master (VC correction) needs d + 1 others
-        d = p.dim
-        need = d + 2 if self.vc is not None else d + 1
-        q = d + d * (d + 1) // 2  # quadratic basis without constant
-        if self.shape == "WTE2":
-            need = max(need, 1 + q)
-        if self.vc in ("V2", "V4", "VC2") or self.test_shape == "WLS2":
-            need = max(need, 2 + q)  # WLS2 with a constant term
-        families_mod.check_supports(p, fam, need, "{}{}".format(
-            self.shape, " with VC correction" if self.vc else ""))
 
     @property
     def N(self):
@@ -837,6 +581,16 @@ _PPG_HOWTO = ("assemble it with skfem_pg.assemble(form, basis) (it takes "
               "generic path and the test basis given explicitly: "
               "bilinear form.assemble(basis, basis.test), linear "
               "form.assemble(basis.test, ...)")
+
+
+def _as_particles(particles):
+    if isinstance(particles, fem.Mesh):
+        particles = Particles.from_mesh(particles)
+    if not isinstance(particles, Particles):
+        raise TypeError("particles must be a skfem_pg.Particles or a "
+                        "scikit-fem mesh, got {}"
+                        .format(type(particles).__name__))
+    return particles
 
 
 def _check_generic_assembly(basis, frame):

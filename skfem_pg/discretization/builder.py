@@ -1,0 +1,521 @@
+r"""How a :class:`~skfem_pg.FamilyBasis` is made: a recipe record and the
+stages one builder composes.
+
+A basis is the result of a fixed sequence of stages, each a plain function
+of the particles, the :class:`BasisSpec` (every option, resolved and
+checked once) and what the earlier stages computed:
+
+1. **families** — a rule of
+   :data:`skfem_pg.discretization.families.RULES` or given
+   :class:`~skfem_pg.Families`; PPG completes them to pairwise ones;
+2. **trial derivatives** :math:`G^{kji}` — a shape function of
+   :data:`skfem_pg.discretization.shape.GRADIENTS` (MTE1/WTE1 (3.32),
+   WTE2), then the bond correction (5.55);
+3. **quadrature weights** — PBG's rule of
+   :mod:`~skfem_pg.discretization.quadrature` ((4.30) or uniform), PPG's
+   member volumes :math:`V^j`;
+4. **test derivatives at the masters** (PPG) — a rule of
+   :data:`TEST_GRADIENTS`;
+5. **variational consistency** — a correction of :data:`CORRECTIONS`
+   (first-order VC (5.18) of PBG and PPG1, (5.17) of PPG2, second-order
+   VC2), checked by
+   :func:`~skfem_pg.discretization.corrections.check_correction`.
+
+:func:`build` runs them and returns the computed arrays
+(:class:`BasisArrays`); :class:`~skfem_pg.FamilyBasis` holds them behind
+scikit-fem's basis interface.  The default PBG pipeline with MTE1/WTE1 and
+V3/V5 or no correction runs stages 2–5 one family-size group at a time
+(:mod:`skfem_pg.discretization.layout`), without padding.
+
+A new shape function, family rule, test rule or correction is one function
+plus one entry in its table (``GRADIENTS``, ``RULES``,
+:data:`TEST_GRADIENTS`, :data:`CORRECTIONS`).  The thesis names of Table 7.1
+produce a :class:`BasisSpec` through :meth:`BasisSpec.from_name`.
+"""
+import dataclasses
+import time
+import warnings
+from typing import Optional
+
+import numpy as np
+
+from . import families as families_mod
+from . import petrov
+from . import recipes
+from ..errors import FamilyError, describe_particle
+from .corrections import (bond_correction, check_correction,
+                          correction_functions, vc_correction)
+from .families import Families
+from .quadrature import weight_rule
+from .shape import GRADIENTS
+from .shape.least_squares import (mls1_master_gradients,
+                                   wls1_master_gradients,
+                                   wls2_master_gradients)
+from .shape.lme import lme_master_gradients
+from .vc2 import vc2_correction
+from ..naming import parse
+
+METHODS = ("PBG", "PPG1", "PPG2")
+#: the VC variants each kind of method accepts
+#: (:func:`~skfem_pg.discretization.corrections.correction_functions`)
+VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
+               "PPG": ("V1", "V2", "V3", "V4", "VC2")}
+
+
+def _trial_at_master(p, fam, G, spec):
+    return G[:, 0]
+
+
+def _wte1_at_master(p, fam, G, spec):
+    return GRADIENTS["WTE1"](p.x, p.volumes, fam,
+                             n=spec.weight_exponent)[:, 0]
+
+
+def _least_squares(rule):
+    def at_master(p, fam, G, spec):
+        return rule(p.x, p.volumes, fam, n=spec.weight_exponent)
+    at_master.__name__ = rule.__name__
+    return at_master
+
+
+def _lme_at_master(p, fam, G, spec):
+    g, ok = lme_master_gradients(p.x, fam, mu=spec.lme_mu)
+    out = G[:, 0].copy()
+    out[ok] = g[ok]  # LME degenerates at surface masters: keep the trial's
+    return out
+
+
+#: PPG test derivatives at the masters, ``test_shape`` ->
+#: ``f(particles, families, G, spec)`` returning ``(nf, m, d)``
+TEST_GRADIENTS = {
+    "master": _trial_at_master,
+    "WTE1": _wte1_at_master,
+    "WLS1": _least_squares(wls1_master_gradients),
+    "WLS2": _least_squares(wls2_master_gradients),
+    "MLS1": _least_squares(mls1_master_gradients),
+    "LME": _lme_at_master,
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class BasisSpec:
+    """Every option of a :class:`~skfem_pg.FamilyBasis`, resolved: no
+    ``"auto"`` / ``None`` defaults left, checked against each other once.
+    The keywords mean what :class:`~skfem_pg.FamilyBasis` documents; make
+    one with :meth:`resolve` (keywords) or :meth:`from_name` (a Table 7.1
+    name), build the basis with ``FamilyBasis.from_spec``."""
+
+    families: object  # rule name or Families
+    shape: str
+    bond: bool
+    vc: Optional[str]
+    method: str
+    dim: Optional[int]
+    weights: str
+    weight_exponent: float
+    vc_solver: str = "auto"
+    vc_exclude: object = None
+    test_shape: str = "master"
+    lme_mu: float = 1.8
+    vc_boundary: str = "min-norm"
+    vc_tolerance: Optional[float] = 1e-8
+    #: the name of :data:`skfem_pg.discretization.recipes.RECIPES` whose
+    #: families, weights and exponent these are, else ``None``
+    recipe: Optional[str] = None
+
+    @property
+    def ppg(self):
+        return self.method != "PBG"
+
+    @property
+    def grouped(self):
+        """Whether the stages run per family-size group, without padding
+        (PBG with MTE1/WTE1, vc V3/V5 or none, no excluded particles,
+        boundary ``min-norm`` / ``p``)."""
+        return (not self.ppg and self.shape in ("MTE1", "WTE1")
+                and self.vc in (None, "V3", "V5") and self.vc_exclude is None
+                and self.vc_boundary in ("min-norm", "p"))
+
+    def options(self):
+        """The keywords that rebuild a basis of this spec on moved particles
+        (updated Lagrange): the family rule, not the families."""
+        out = {f.name: getattr(self, f.name)
+               for f in dataclasses.fields(self)
+               if f.name not in ("families", "recipe")}
+        if isinstance(self.families, str):
+            out["families"] = self.families
+        return out
+
+    @classmethod
+    def from_name(cls, particles, name, families=None, **kwargs):
+        """The spec of a thesis name (Table 7.1, :mod:`skfem_pg.naming`)
+        and its notes; ``kwargs`` override what the name says."""
+        kw, notes = parse(name)
+        if particles.mesh is None and kw.get("families") == "mesh":
+            kw["families"] = "horizon"  # the thesis' rule without a mesh
+        if families is not None:
+            kw["families"] = families
+        return cls.resolve(particles, **{**kw, **kwargs}), notes
+
+    @classmethod
+    def resolve(cls, particles, families=None, shape="MTE1", bond=None,
+                vc="auto", method="PBG", dim=None, weight_exponent="auto",
+                vc_solver="auto", vc_exclude=None, test_shape="master",
+                lme_mu=1.8, vc_boundary="min-norm", vc_tolerance=1e-8,
+                weights="auto", area_vectors=None):
+        """The spec of :class:`~skfem_pg.FamilyBasis`'s keywords, defaults
+        filled in; raises ``ValueError`` / ``NotImplementedError`` naming
+        the option for a combination the stages cannot build
+        (``area_vectors`` is only checked for presence)."""
+        if dim is not None and (isinstance(dim, bool) or dim
+                                != particles.dim):
+            raise ValueError(
+                "dim={!r} components on {}-D particles: a vector field "
+                "(displacements) has dim={}, a scalar field dim=None"
+                .format(dim, particles.dim, particles.dim))
+        if method not in METHODS:
+            raise NotImplementedError(
+                "method {!r} is not available; this version implements {}"
+                .format(method, ", ".join(METHODS)))
+        if shape not in GRADIENTS:
+            raise ValueError("unknown shape functions {!r}; available: {}"
+                             .format(shape, ", ".join(GRADIENTS)))
+        ppg = method != "PBG"
+        if bond is None:  # PPG too: without it VC PPG1 is unstable
+            bond = shape == "MTE1"
+        if bond and shape == "WTE2":
+            raise ValueError("the bond correction (5.55) is for linear "
+                             "bases; use bond=False with shape='WTE2'")
+        if vc == "auto":
+            vc = {"MTE1": "V5" if bond and not ppg else "V3",
+                  "WTE2": "V3"}.get(shape)
+        if vc == "VC2" and (shape != "WTE2" or method == "PPG2"):
+            raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
+                             "trial basis: shape='WTE2', method='PBG' or "
+                             "'PPG1'")
+        if test_shape not in TEST_GRADIENTS:
+            raise ValueError("test_shape must be one of {}, got {!r}".format(
+                ", ".join(TEST_GRADIENTS), test_shape))
+        if test_shape != "master" and not ppg:
+            raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
+                             "use method='PPG1' or 'PPG2'".format(test_shape))
+        allowed = VC_VARIANTS["PPG" if ppg else "PBG"]
+        if vc is not None and vc not in allowed:
+            raise ValueError("vc={!r} is not available for {}: use one of {} "
+                             "or None".format(vc, method, ", ".join(allowed)))
+        if vc == "V5" and not bond:
+            raise ValueError("vc='V5' keeps the bond mapping and needs "
+                             "bond=True; use vc='V3' without bond correction")
+        if vc_boundary != "min-norm" and (
+                vc is None or method == "PPG2"
+                or (vc == "VC2" and vc_boundary != "s")):
+            raise NotImplementedError(
+                "vc_boundary={!r} is implemented for the first-order VC of "
+                "PBG and PPG1 (vc V1, V3, V4, V5) and, 's' only, for VC2; "
+                "not for {} vc={}".format(vc_boundary, method, vc))
+        if vc is not None and area_vectors is None and particles.mesh is None:
+            raise ValueError(
+                "the VC correction needs surface area vectors A^i: these "
+                "particles have no mesh, so pass area_vectors= (shape "
+                "(dim, n)) or use vc=None")
+        if ppg and weights not in ("auto", None, "volume"):
+            raise ValueError("weights={!r} is a PBG option: PPG integrates "
+                             "with the member volumes V^j".format(weights))
+        if families is None and shape == "WTE2":
+            # twice the d + d(d+1)/2 quadratic moments, plus the master:
+            # with fewer, corner families of graded meshes (Cook's (48,
+            # 60) at 7 members) give a singular WTE2 moment matrix
+            d = particles.dim
+            families = families_mod.horizon(
+                particles, factor=2.51,
+                min_size=1 + 2 * (d + d * (d + 1) // 2))
+        elif families is None and particles.mesh is None:
+            families = "horizon"
+        families, weights, weight_exponent, recipe = recipes.resolve(
+            particles, families, weights, weight_exponent, method, shape)
+        weight_rule(weights)  # a known rule, or ValueError naming it
+        return cls(families=families, shape=shape, bond=bool(bond), vc=vc,
+                   method=method, dim=dim, weights=weights,
+                   weight_exponent=recipes.check_exponent(weight_exponent),
+                   vc_solver=vc_solver, vc_exclude=vc_exclude,
+                   test_shape=test_shape, lme_mu=lme_mu,
+                   vc_boundary=vc_boundary, vc_tolerance=vc_tolerance,
+                   recipe=recipe)
+
+
+@dataclasses.dataclass
+class BasisArrays:
+    """What :func:`build` computes.  ``G`` (padded ``(nf, m, m, d)``) or
+    ``G_groups`` (per size group, the grouped pipeline) holds the trial
+    derivatives; ``test_master`` PPG's ``(nf, m, d)`` test derivatives at
+    the masters (``None`` for PBG)."""
+
+    families: Families
+    dx: np.ndarray
+    G: Optional[np.ndarray] = None
+    G_groups: Optional[list] = None
+    test_master: Optional[np.ndarray] = None
+    vc_report: object = None
+    timings: dict = dataclasses.field(default_factory=dict)
+
+
+@dataclasses.dataclass
+class _Context:
+    """What a correction of :data:`CORRECTIONS` reads and writes."""
+
+    particles: object
+    spec: BasisSpec
+    families: Families
+    G: np.ndarray
+    dx: np.ndarray
+    Gt: Optional[np.ndarray]  # (nf, m, m, d), the masters' rows filled
+    dx_t: Optional[np.ndarray]
+    area: np.ndarray
+    vc_solve: object  # vc_correction, or a partition's
+    report: object = None
+
+    @property
+    def surface(self):
+        p = self.particles
+        return p.surface_area_vectors() if p.mesh is not None else None
+
+    def phi(self, variant):
+        p = self.particles
+        return correction_functions(variant, p.x, p.volumes, self.families,
+                                    n=self.spec.weight_exponent)
+
+
+def _first_order_pbg(c):
+    s, p = c.spec, c.particles
+    c.G, c.report = vc_correction(
+        c.G, c.dx, p.x, p.volumes, c.families, c.area, c.phi(s.vc),
+        variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
+        boundary=s.vc_boundary, surface=c.surface)
+
+
+def _first_order_ppg1(c):
+    # (5.16) is (5.18) with the master weights only
+    s, p = c.spec, c.particles
+    c.Gt, c.report = c.vc_solve(
+        c.Gt, c.dx_t, p.x, p.volumes, c.families, c.area, c.phi(s.vc),
+        variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
+        boundary=s.vc_boundary, surface=c.surface)
+
+
+def _first_order_ppg2(c):  # (5.17), its own sparse system
+    warnings.warn(
+        "VC PPG2 passes the patch test but is unstable here: "
+        "its tangent has eigenvalues with negative real part "
+        "(e.g. 4 on a regular 20x10 block) and it does not "
+        "converge on a manufactured solution; prefer PPG1")
+    s, p = c.spec, c.particles
+    Gm, c.report = petrov.ppg2_vc_correction(
+        c.Gt[:, 0], p.volumes, c.families, c.area, c.phi(s.vc),
+        exclude=s.vc_exclude)
+    c.Gt[:, 0] = Gm
+
+
+def _second_order_pbg(c):
+    # V4-type functions keep the trial's quadratic consistency
+    s, p = c.spec, c.particles
+    c.G, c.report = vc2_correction(
+        c.G, c.dx, p.x, p.volumes, c.families, c.area, p.area_moments(),
+        c.phi(s.vc), exclude=s.vc_exclude, boundary=s.vc_boundary,
+        surface=c.surface)
+
+
+def _second_order_ppg1(c):
+    # corrects the test functions only: V1 functions (VC2PPG V1s U2)
+    warnings.warn(
+        "VC2 PPG1 (VC2PPG V1 U2) passes the quadratic patch "
+        "test but is unstable here: its free tangent has "
+        "eigenvalues with negative real part (40 on a regular "
+        "20x10 block, 214 distorted) and it does not converge "
+        "on a manufactured solution; prefer PBG's VC2")
+    s, p = c.spec, c.particles
+    c.Gt, c.report = vc2_correction(
+        c.Gt, c.dx_t, p.x, p.volumes, c.families, c.area, p.area_moments(),
+        c.phi("V1"), exclude=s.vc_exclude, boundary=s.vc_boundary,
+        method="PPG1", surface=c.surface)
+
+
+#: VC corrections of the padded pipeline, ``(method, order)`` ->
+#: ``f(context)`` updating ``context.G`` (PBG) or ``context.Gt`` (PPG) and
+#: ``context.report``; order 1 is every first-order variant V1–V5, order 2
+#: is ``vc="VC2"``
+CORRECTIONS = {
+    ("PBG", 1): _first_order_pbg,
+    ("PPG1", 1): _first_order_ppg1,
+    ("PPG2", 1): _first_order_ppg2,
+    ("PBG", 2): _second_order_pbg,
+    ("PPG1", 2): _second_order_ppg1,
+}
+
+
+def area_vectors_of(particles, area_vectors):
+    """``area_vectors`` (default: the particles' FE-consistent ones) as a
+    checked ``(dim, np)`` array."""
+    x = particles.x
+    if area_vectors is None:
+        area_vectors = particles.area_vectors()
+    area_vectors = np.asarray(area_vectors, dtype=float)
+    if area_vectors.shape != x.shape:
+        raise ValueError("area_vectors must have shape {}, got {}"
+                         .format(x.shape, area_vectors.shape))
+    return area_vectors
+
+
+def make_families(particles, spec, distributed=None):
+    """Stage 1: the spec's families (a rule is applied; PPG's made
+    pairwise unless a partition made them), checked for the members the
+    shape functions and corrections need."""
+    fam = spec.families
+    if isinstance(fam, str):
+        fam = families_mod.build(fam, particles)
+    if spec.ppg and distributed is None:  # a partition's come complete
+        fam = petrov.pairwise(fam)
+    check_family_sizes(particles, fam, spec)
+    return fam
+
+
+def check_family_sizes(p, fam, spec):
+    """Raise :class:`~skfem_pg.errors.FamilyError` naming a particle whose
+    family is too small for the spec: linear Taylor expansions need ``d``
+    others, WTE2 ``d + d(d+1)/2``; MLS1 at the master (VC) ``d + 1``,
+    second-order corrections and WLS2 a quadratic basis and a constant."""
+    if fam.n_particles != p.n:
+        raise FamilyError("families refer to {} particles, the particle "
+                          "set has {}".format(fam.n_particles, p.n))
+    inactive = ~p.active[fam.members]
+    if np.any(inactive):
+        q = fam.members[np.nonzero(inactive)[0][0]]
+        raise FamilyError("{} has zero volume but is a family member"
+                          .format(describe_particle(q, p.x[:, q])))
+    d = p.dim
+    need = d + 2 if spec.vc is not None else d + 1
+    q = d + d * (d + 1) // 2  # quadratic basis without constant
+    if spec.shape == "WTE2":
+        need = max(need, 1 + q)
+    if spec.vc in ("V2", "V4", "VC2") or spec.test_shape == "WLS2":
+        need = max(need, 2 + q)  # WLS2 with a constant term
+    families_mod.check_supports(p, fam, need, "{}{}".format(
+        spec.shape, " with VC correction" if spec.vc else ""))
+
+
+def trial_gradients(particles, fam, spec, timings):
+    """Stage 2: the shape functions' derivatives, bond-corrected if the
+    spec says so."""
+    t0 = time.perf_counter()
+    G = GRADIENTS[spec.shape](particles.x, particles.volumes, fam,
+                              n=spec.weight_exponent)
+    timings["gradients"] = timings.get("gradients", 0.0) + (
+        time.perf_counter() - t0)
+    if spec.bond:
+        t0 = time.perf_counter()
+        G = bond_correction(G, particles.x, fam)
+        timings["bond"] = timings.get("bond", 0.0) + (
+            time.perf_counter() - t0)
+    return G
+
+
+def _what(spec):
+    if spec.vc is None:
+        return "{} {}".format(spec.method, spec.shape)
+    return "VC {} ({}{})".format(
+        spec.vc, spec.method, "" if spec.vc_boundary == "min-norm"
+        else ", boundary " + spec.vc_boundary)
+
+
+def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
+    x, V = particles.x, particles.volumes
+    G = trial_gradients(particles, fam, spec, timings)
+    Gt = dx_t = None
+    if spec.ppg:
+        dx = petrov.quadrature_weights(V, fam)
+        Gt = np.zeros_like(G)
+        Gt[:, 0] = TEST_GRADIENTS[spec.test_shape](particles, fam, G, spec)
+        mem, mask = fam.padded()
+        dx_t = np.zeros_like(V[mem] * mask)
+        dx_t[:, 0] = V[fam.masters]
+    else:
+        dx = weight_rule(spec.weights)(V, fam)
+    report = None
+    if spec.vc is not None:
+        t0 = time.perf_counter()
+        c = _Context(particles, spec, fam, G, dx, Gt, dx_t,
+                     area_vectors_of(particles, area_vectors), vc_solve)
+        CORRECTIONS[spec.method, 2 if spec.vc == "VC2" else 1](c)
+        G, Gt, report = c.G, c.Gt, c.report
+        timings["vc"] = time.perf_counter() - t0
+    check_correction(Gt if spec.ppg else G, x, fam, report,
+                     spec.vc_tolerance, what=_what(spec))
+    if spec.ppg:  # the trial derivatives too
+        check_correction(G, x, fam, None, what=spec.shape + " trial")
+    return BasisArrays(fam, dx, G=G, vc_report=report, timings=timings,
+                       test_master=None if Gt is None else Gt[:, 0])
+
+
+def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
+    """PBG with MTE1/WTE1 derivatives, bond and V3/V5 correction, one size
+    group at a time: work and storage :math:`\\propto \\sum_k m_k^2`
+    instead of :math:`n_f m_{max}^2`; the kernels are the padded ones, run
+    on each group's own families."""
+    x, V = particles.x, particles.volumes
+    L = fam.groups()
+    subs = [L.subset(g) for g in L]
+    Gs = [trial_gradients(particles, f, spec, timings) for f in subs]
+    weigh = weight_rule(spec.weights)
+    dxs = [weigh(V, f) for f in subs]
+    flat = np.empty(L.n_points)
+    for g, d in zip(L, dxs):
+        flat[g.flat] = d
+    report = None
+    if spec.vc is not None:
+        t0 = time.perf_counter()
+        area = area_vectors_of(particles, area_vectors)
+        phis = [correction_functions(spec.vc, x, V, f,
+                                     n=spec.weight_exponent) for f in subs]
+        Gs, report = vc_solve(
+            Gs, dxs, x, V, subs, area, phis, variant=spec.vc,
+            solver=spec.vc_solver, boundary=spec.vc_boundary,
+            surface=(particles.surface_area_vectors()
+                     if particles.mesh is not None else None),
+            index=[g.families for g in L])
+        timings["vc"] = time.perf_counter() - t0
+    check_correction(Gs, x, subs, report, spec.vc_tolerance,
+                     what=_what(spec))
+    return BasisArrays(fam, L.flat_to_padded(flat), G_groups=Gs,
+                       vc_report=report, timings=timings)
+
+
+def distributed_supports(spec):
+    """Whether a partition can build ``spec``: the grouped PBG pipeline, or
+    PPG1 with vc V3 or none, boundary ``min-norm`` and master test
+    derivatives (its VC solve and test derivatives span the ranks)."""
+    return spec.grouped or (
+        spec.method == "PPG1" and spec.vc in (None, "V3")
+        and spec.vc_boundary == "min-norm" and spec.test_shape == "master")
+
+
+def build(particles, spec, area_vectors=None, distributed=None):
+    """Run the stages of ``spec`` on ``particles``; ``distributed`` (a
+    :class:`~skfem_pg.distributed.Partition`) supplies the VC solve of all
+    ranks.  Returns :class:`BasisArrays`."""
+    if distributed is not None and not distributed_supports(spec):
+        raise NotImplementedError(
+            "a distributed basis is PBG with MTE1/WTE1 and vc V3/V5 "
+            "or None, or PPG1 with vc V3 or None")
+    timings = {}
+    t0 = time.perf_counter()
+    fam = make_families(particles, spec, distributed)
+    timings["families"] = time.perf_counter() - t0
+    vc_solve = (vc_correction if distributed is None
+                else distributed.vc_correction)
+    stages = _grouped if spec.grouped else _padded
+    return stages(particles, fam, spec, area_vectors, vc_solve, timings)
+
+
+__all__ = ["BasisArrays", "BasisSpec", "CORRECTIONS", "METHODS",
+           "TEST_GRADIENTS", "VC_VARIANTS", "area_vectors_of", "build",
+           "check_family_sizes", "distributed_supports", "make_families",
+           "trial_gradients"]
