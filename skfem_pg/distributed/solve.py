@@ -23,7 +23,8 @@ from . import petsc as pt
 from .comm import mpi
 from ..dofs import as_dofs
 from ..solvers.result import Result
-from ..solvers.static import ConvergenceError, verdict
+from ..solvers.static import (LinearSolveFailed, NewtonControls,
+                              load_stepping, newton_iterations)
 
 
 def _dirichlet(part, D, u_D):
@@ -93,11 +94,20 @@ def solve(K, part, f=None, D=None, u_D=None, options=None, symmetric=True,
                "t_linear": t2 - t1}
 
 
-def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
-           maxiter=25, min_step=1.0 / 64, options=None, rtol=1e-8,
-           verbose=True):
+#: the distributed Newton's defaults where they differ from the serial
+#: ones (:class:`~skfem_pg.solvers.static.NewtonControls`): no secant
+#: predictor, a tighter tolerance, at most six halvings
+DISTRIBUTED_DEFAULTS = {"tol": 1e-10, "min_step": 1.0 / 64,
+                        "predictor": False}
+
+
+def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
+           rtol=1e-8, controls=None, **kw):
     r"""Newton's method for :math:`f_{int}(u) = \lambda f_{ext}` up to
-    :math:`\lambda = 1` on a distributed model, with adaptive load steps.
+    :math:`\lambda = 1` on a distributed model, with adaptive load steps:
+    the serial driver (:func:`~skfem_pg.solvers.static.load_stepping`,
+    :func:`~skfem_pg.solvers.static.newton_iterations`) on PETSc vectors
+    and Krylov solves (:class:`PetscAlgebra`).
 
     ``model`` is a displacement model (e.g.
     :class:`~skfem_pg.formulations.Hyperelastic`) on the rank's local
@@ -106,24 +116,25 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
     factor 1 (scaled) or a callable ``u_D(t)`` returning it at load
     factor ``t`` (a rotation), as in the serial solver.
 
-    A step converges when :math:`|r_{free}| \le` ``tol``
-    :math:`\max(|\lambda f_{ext}|, |r_0|)`, or by the serial solver's
-    energy and round-off-floor criteria (:func:`skfem_pg.solvers.newton`).
-    Each linear solve is :func:`~skfem_pg.distributed.petsc.krylov` (CG +
-    GAMG to the relative tolerance ``rtol``; ``options`` override): the
-    answer's accuracy is set by ``tol`` on the true residual, an inexact
-    solve only costs iterations.  A step that does not converge within
-    ``maxiter``, reaches :math:`J \le 0` or a non-finite residual, or
-    whose Krylov solve diverges (an indefinite tangent far from
-    equilibrium) is halved; a step that converges in at most 4
-    iterations doubles the next (the serial policy).  Below ``min_step``
-    :class:`~skfem_pg.solvers.ConvergenceError` is raised.
+    ``controls`` / ``kw``: the serial
+    :class:`~skfem_pg.solvers.static.NewtonControls` (``steps``, ``tol``,
+    ``maxiter``, ``min_step``, ``adaptive``, ``predictor``,
+    ``line_search``, ``verbose``), defaults :data:`DISTRIBUTED_DEFAULTS`.
+    A step converges by the serial criteria.  Each linear solve is
+    :func:`~skfem_pg.distributed.petsc.krylov` (CG + GAMG to the relative
+    tolerance ``rtol``; PETSc ``options`` override): the answer's accuracy
+    is set by ``tol`` on the true residual, an inexact solve only costs
+    iterations.  A step that does not converge within ``maxiter``,
+    reaches :math:`J \le 0` or a non-finite residual, or whose Krylov
+    solve diverges (an indefinite tangent far from equilibrium) is
+    halved, as in the serial solver.
 
     Returns ``(u, history)`` like :func:`skfem_pg.solvers.newton`: ``u``
     in the serial numbering on every rank, ``history`` one dict per
     converged step (load, residual norms, increment energies, KSP
     iterations, minimum J, seconds).
     """
+    opts = NewtonControls.of(controls, defaults=DISTRIBUTED_DEFAULTS, **kw)
     if getattr(model, "N", None) != getattr(model, "n_u", model.N):
         raise NotImplementedError(
             "{} has global extra fields; the distributed Newton solves "
@@ -143,109 +154,119 @@ def newton(model, part, f_ext=None, D=None, u_D=None, steps=1, tol=1e-10,
 
         def prescribed(t):
             return t * values
-    U = pt.empty_vector(part)
-    history = []
-    lam, dlam = 0.0, 1.0 / steps
-    while lam < 1.0 - 1e-14:
-        target = min(1.0, lam + dlam)
-        t0 = time.perf_counter()
-        ok, Uk, info, state = _newton_step(model, part, U, target, F, rows,
-                                           prescribed(target), tol, maxiter,
-                                           options, rtol)
-        info.update(load=target, seconds=time.perf_counter() - t0)
-        if verbose and part.rank == 0:
-            print("  load {:.4f}: {} in {} it, |r| {}, KSP {}, min J "
-                  "{:.3g}".format(
-                      target, "converged" if ok else "FAILED ({})".format(
-                          info["reason"]), len(info["residuals"]) - 1,
-                      " ".join("{:.1e}".format(r)
-                               for r in info["residuals"]),
-                      info["krylov"], info["min_J"]), flush=True)
-        if ok:
-            if hasattr(model, "commit"):
-                model.commit(state)
-            U.destroy()
-            U, lam = Uk, target
-            history.append(info)
-            if len(info["residuals"]) <= 5:
-                dlam = min(2 * dlam, 1.0)
-            continue
-        Uk.destroy()
-        dlam = (target - lam) / 2
-        if dlam < min_step:
-            raise ConvergenceError(
-                "Newton failed at load factor {:.6g} ({}); the step fell "
-                "below min_step = {:.3g} after reaching load {:.6g}".format(
-                    target, info["reason"], min_step, lam), load=lam,
-                u=part.gather(U), history=history)
-    return part.gather(U), history
+    algebra = PetscAlgebra(model, part, F, rows, options, rtol)
+
+    def step(start, target):
+        n0 = len(algebra.krylov)
+        out = newton_iterations(model, algebra, start, target,
+                                prescribed(target), opts.tol, opts.maxiter,
+                                opts.line_search)
+        out[2]["krylov"] = algebra.krylov[n0:]
+        return out
+
+    return load_stepping(model, step, algebra, pt.empty_vector(part), 0.0,
+                         1.0 / opts.steps, opts,
+                         echo=print if part.rank == 0 else _silent)
 
 
-def _newton_step(model, part, U0, lam, F, rows, prescribed, tol, maxiter,
-                 options, rtol):
-    """Newton iterations at load factor ``lam`` from the converged ``U0``
-    (not changed), ``prescribed`` the values at ``rows`` at this load.
-    Returns ``(ok, U, info, state)``."""
-    MPI = mpi()
-    U = U0.copy()
-    res, energy = [], []  # residual norms, |dU . R| per solve
-    info = {"residuals": res, "energies": energy, "krylov": [],
-            "min_J": np.nan, "reason": "", "t_assemble": 0.0,
-            "t_linear": 0.0}
-    pending = part.comm.allreduce(
-        bool(np.any(prescribed != U.getValues(rows))) if len(rows)
-        else False, op=MPI.LOR)
-    ref = None
-    for it in range(maxiter + 1):
-        t0 = time.perf_counter()
-        state = model.state(pt.to_local(U, part))
-        info["min_J"] = part.comm.allreduce(model.min_J(state), op=MPI.MIN)
-        if not info["min_J"] > 0:
-            info["reason"] = "J <= 0"
-            return False, U, info, None
-        R = pt.vector(-model.internal_force(state), part)
-        R.axpy(lam, F)  # R = lam f_ext - f_int
-        if len(rows):
-            R.setValues(rows, np.zeros(len(rows)))
+def _silent(*args, **kwargs):
+    pass
+
+
+class PetscAlgebra:
+    """The linear algebra of the serial Newton driver
+    (:func:`~skfem_pg.solvers.static.newton_iterations`) on a partition:
+    PETSc vectors of the owned dofs, the model evaluated on the rank's
+    local dofs (:func:`~skfem_pg.distributed.petsc.to_local`), the minimum
+    J reduced over the ranks, Dirichlet rows ``rows`` by
+    ``MatZeroRowsColumns`` and Krylov solves
+    (:func:`~skfem_pg.distributed.petsc.krylov`, ``ksp_options``,
+    ``rtol``)."""
+
+    def __init__(self, model, part, F, rows, ksp_options=None, rtol=1e-8):
+        self.model, self.part, self.F, self.rows = model, part, F, rows
+        self.ksp_options, self.rtol = ksp_options, rtol
+        self.krylov = []  # KSP iterations of every solve
+    @staticmethod
+    def copy(u):
+        return u.copy()
+
+    @staticmethod
+    def add(u, du, s=1.0):
+        u.axpy(s, du)
+        return u
+
+    @staticmethod
+    def extrapolate(u, prev, c):
+        diff = u.copy()
+        diff.axpy(-1.0, prev)
+        out = u.copy()
+        out.axpy(c, diff)
+        diff.destroy()
+        return out
+
+    @staticmethod
+    def release(u):
+        u.destroy()
+
+    def serial(self, u):
+        return self.part.gather(u)
+
+    def increment_at_dirichlet(self, u, values):
+        rows = self.rows
+        current = u.getValues(rows) if len(rows) else np.zeros(0)
+        pending = self.part.comm.allreduce(
+            bool(np.any(values != current)), op=mpi().LOR)
+        return values - current, pending
+
+    def state(self, u):
+        return self.model.state(pt.to_local(u, self.part))
+
+    def min_J(self, state):
+        return self.part.comm.allreduce(self.model.min_J(state),
+                                        op=mpi().MIN)
+
+    def residual(self, state, lam):
+        """``R = λ f_ext - f_int`` with zeros at the Dirichlet rows, its
+        norm, and ``None`` (the internal force stays distributed)."""
+        R = pt.vector(-self.model.internal_force(state), self.part)
+        R.axpy(lam, self.F)
+        if len(self.rows):
+            R.setValues(self.rows, np.zeros(len(self.rows)))
         R.assemble()
-        rn = R.norm()
-        res.append(rn)
-        if not np.isfinite(rn):
-            info["reason"] = "non-finite residual"
-            return False, U, info, None
-        if not pending:  # the serial solver's criteria
-            if ref is None:
-                ref = max(lam * F.norm(), rn, 1e-300)
-            done, info["reason"] = verdict(res, energy, ref, tol)
-            if done is not None:
-                return done, U, info, state if done else None
-        if it == maxiter:
-            info["reason"] = "maxiter"
-            return False, U, info, None
-        K = pt.matrix(model.tangent(state), part)
-        inc = (prescribed - U.getValues(rows) if pending
-               else np.zeros(len(rows)))
-        _lifted(K, R, rows, inc, part)
-        if it == 0:
-            pt.check_rigid_body_modes(K, part)
+        return R, R.norm(), None
+
+    def load_norm(self, lam):
+        return lam * self.F.norm()
+
+    def solve(self, state, u, R, du_D, first):
+        t0 = time.perf_counter()
+        K = pt.matrix(self.model.tangent(state), self.part)
+        _lifted(K, R, self.rows,
+                np.zeros(len(self.rows)) if du_D is None else du_D,
+                self.part)
+        if first:
+            pt.check_rigid_body_modes(K, self.part)
         t1 = time.perf_counter()
-        ksp = pt.krylov(K, part, options, rtol=rtol)
+        ksp = pt.krylov(K, self.part, self.ksp_options, rtol=self.rtol)
         try:
-            dU, its = pt.solve_ksp(ksp, R, part)
+            dU, its = pt.solve_ksp(ksp, R, self.part)
         except pt.KSPError as err:  # an indefinite tangent: cut the step
-            info["reason"] = "KSP diverged (reason {})".format(err.reason)
-            return False, U, info, None
+            raise LinearSolveFailed("KSP diverged (reason {})".format(
+                err.reason)) from None
         finally:
             ksp.destroy()
             K.destroy()
-        energy.append(abs(dU.dot(R)))
-        U.axpy(1.0, dU)
-        dU.destroy()
-        _impose(U, rows, prescribed)  # the Krylov solve is inexact there
-        pending = False
-        info["krylov"].append(its)
-        info["t_assemble"] += t1 - t0
-        info["t_linear"] += time.perf_counter() - t1
+        self.krylov.append(its)
+        return dU, abs(dU.dot(R)), t1 - t0, time.perf_counter() - t1
+
+    def impose(self, u, values):
+        _impose(u, self.rows, values)  # the Krylov solve is inexact there
+        return u
+
+    @staticmethod
+    def small_increment(du, u):
+        return False
 
 
 @dataclass

@@ -13,6 +13,7 @@ converged one.  A step is cut in half when Newton diverges, exceeds
 halving the increment); a :class:`ConvergenceError` names the load factor
 once the step would fall below ``min_step``.
 """
+import dataclasses
 import time
 
 import numpy as np
@@ -62,10 +63,89 @@ def condensed_solver(kind, basis, I, extra_fields=False):
                          else I % locs.shape[0])
 
 
-def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
-           tol=1e-9, maxiter=25, min_step=1.0 / 1024, solver="auto",
-           adaptive=True, predictor=True, verbose=True, load0=0.0,
-           callback=None, line_search=False, checkpoint=None, resume=None):
+@dataclasses.dataclass(frozen=True)
+class NewtonControls:
+    r"""The controls of Newton's method with adaptive load stepping, shared
+    by :func:`newton` and the distributed
+    :func:`skfem_pg.distributed.newton` (which pass their keywords of these
+    names into one record).
+
+    Attributes
+    ----------
+    steps
+        Initial number of load steps (the step then adapts).
+    tol
+        Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
+        ``r_0`` is the first residual of the step; or every field's Newton
+        increment below ``1e-10`` of its magnitude; or the energy of the
+        last increment :math:`|\Delta x\cdot r|` below ``tol²`` times
+        that of the first (a measure in units of work, whatever the
+        fields: with pressures and dilatations as unknowns the residual
+        norm mixes units); or, once the residual stops decreasing (its
+        round-off floor, set by the bulk modulus and not by the load),
+        that energy below ``ROUNDOFF_ENERGY · tol`` times the first
+        (the history's ``reason`` then says "round-off floor").
+    maxiter
+        Newton iterations per load step at most.
+    min_step
+        The smallest load step: a step that would be cut below it raises
+        :class:`ConvergenceError`.
+    adaptive
+        ``True``: a step that converges in at most 4 iterations doubles
+        the next one, a failed step is halved (down to ``min_step``).
+        ``False``: ``steps`` equal steps, and a failed one raises
+        :class:`ConvergenceError` at once (robustness studies: the largest
+        step that converges).
+    predictor
+        Start each load step from the linear extrapolation of the last two
+        converged states (secant predictor) instead of the last one; a
+        step that fails from it is cut like any other.
+    line_search
+        ``True``: halve an increment whose iterate fails, or a later
+        one that raises the residual (at most
+        :data:`LINE_SEARCH_HALVINGS` times), before the step counts as
+        failed (:func:`newton_iterations`).  ``False``: full Newton
+        increments, a failed iterate cuts the step.
+    verbose
+        Print a line per load step (on rank 0 of a distributed run).
+    """
+
+    steps: int = 1
+    tol: float = 1e-9
+    maxiter: int = 25
+    min_step: float = 1.0 / 1024
+    adaptive: bool = True
+    predictor: bool = True
+    line_search: bool = False
+    verbose: bool = True
+
+    def __post_init__(self):
+        _check_controls(steps=self.steps, tol=self.tol, maxiter=self.maxiter,
+                        min_step=self.min_step)
+
+    @classmethod
+    def of(cls, controls=None, defaults=None, **kw):
+        """``controls`` (a record) with ``kw`` (keywords of its field
+        names) replacing fields; ``defaults`` the keywords a driver's
+        record starts from.  An unknown keyword raises ``TypeError``
+        naming it."""
+        known = {f.name for f in dataclasses.fields(cls)}
+        bad = sorted(set(kw) - known)
+        if bad:
+            raise TypeError("unknown Newton control(s) {}: the controls "
+                            "are {}".format(", ".join(bad),
+                                            ", ".join(sorted(known))))
+        if controls is None:
+            controls = cls(**(defaults or {}))
+        elif not isinstance(controls, cls):
+            raise TypeError("controls must be a NewtonControls, got {}"
+                            .format(type(controls).__name__))
+        return dataclasses.replace(controls, **kw) if kw else controls
+
+
+def newton(model, f_ext=None, D=None, u_D=None, u0=None, solver="auto",
+           load0=0.0, callback=None, checkpoint=None, resume=None,
+           controls=None, **kw):
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
@@ -89,37 +169,14 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         Default 0.
     u0
         Initial unknowns (displacements, or all unknowns).
-    steps
-        Initial number of load steps (the step then adapts).
-    tol
-        Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
-        ``r_0`` is the first residual of the step; or every field's Newton
-        increment below ``1e-10`` of its magnitude; or the energy of the
-        last increment :math:`|\Delta x\cdot r|` below ``tol²`` times
-        that of the first (a measure in units of work, whatever the
-        fields: with pressures and dilatations as unknowns the residual
-        norm mixes units); or, once the residual stops decreasing (its
-        round-off floor, set by the bulk modulus and not by the load),
-        that energy below ``ROUNDOFF_ENERGY · tol`` times the first
-        (the history's ``reason`` then says "round-off floor").
     solver
         Linear solver: ``"auto"``, ``"direct"`` or ``"amg"``
         (:func:`linear_solver` on the free dofs), or a callable ``(A, b)
         -> x`` for the condensed systems, e.g. a :func:`linear_solver`
         built once and shared by several calls.
-    adaptive
-        ``True``: a step that converges in at most 4 iterations doubles
-        the next one, a failed step is halved (down to ``min_step``).
-        ``False``: ``steps`` equal steps, and a failed one raises
-        :class:`ConvergenceError` at once (robustness studies: the largest
-        step that converges).
     load0
         The load factor of ``u0``: resume a run there (with a model
         whose history was restored, :mod:`skfem_pg.solvers.checkpoint`).
-    predictor
-        Start each load step from the linear extrapolation of the last two
-        converged states (secant predictor) instead of the last one; a
-        step that fails from it is cut like any other.
     callback
         ``callback(x, load, f_int)`` after each converged (and committed)
         step: its unknowns, load factor and internal force vector (the
@@ -135,12 +192,10 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         A path written by ``checkpoint``: start from it (instead of
         ``u0`` / ``load0``); the run then ends where the uninterrupted run
         ends, to round-off.  A checkpoint of another model raises.
-    line_search
-        ``True``: halve an increment whose iterate fails, or a later
-        one that raises the residual (at most
-        :data:`LINE_SEARCH_HALVINGS` times), before the step counts as
-        failed (:func:`newton_step`).  ``False`` (default): full Newton
-        increments, a failed iterate cuts the step.
+    controls, **kw
+        :class:`NewtonControls` (``steps``, ``tol``, ``maxiter``,
+        ``min_step``, ``adaptive``, ``predictor``, ``line_search``,
+        ``verbose``), or its fields as keywords (they replace the record's).
 
     Returns
     -------
@@ -152,8 +207,8 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         ``reason``, seconds).
 
     """
-    _check_controls(steps=steps, tol=tol, maxiter=maxiter,
-                    min_step=min_step, load0=load0)
+    opts = NewtonControls.of(controls, **kw)
+    _check_controls(load0=load0)
     basis = model.basis
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
@@ -177,7 +232,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         solver, basis, I, extra_fields=N > n_u)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam = float(load0)
-    dlam = (1.0 - lam) / steps if lam < 1.0 else 1.0
+    dlam = (1.0 - lam) / opts.steps if lam < 1.0 else 1.0
     prev = None  # (load, u) of the converged step before the last
     if resume is not None:
         if u0 is not None or load0:
@@ -187,45 +242,67 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
         dlam = float(saved.get("step", dlam))
         if "prev_x" in saved:
             prev = (float(saved["prev_load"]), saved["prev_x"])
+
+    def step(start, target):
+        n_krylov = len(stats["iterations"])
+        out = newton_step(model, start, target, f_ext, Dd,
+                          prescribed(target)[Dd], I, lin, opts.tol,
+                          opts.maxiter, opts.line_search)
+        out[2]["krylov"] = stats["iterations"][n_krylov:]
+        return out
+
+    return load_stepping(model, step, SERIAL, u, lam, dlam, opts, prev=prev,
+                         callback=callback, every=Every.of(checkpoint))
+
+
+def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
+                  callback=None, every=None, echo=print):
+    r"""The load-stepping loop of :func:`newton` and of the distributed
+    :func:`skfem_pg.distributed.newton`: from the converged ``u`` at load
+    factor ``lam`` to :math:`\lambda = 1`, first step ``dlam``.
+
+    ``step(start, target)`` runs Newton at load factor ``target`` from
+    ``start`` and returns ``(ok, x, info, state)``
+    (:func:`newton_iterations`); ``algebra`` is the vector arithmetic of
+    the unknowns (:data:`SERIAL`, or a partition's PETSc vectors):
+    ``extrapolate`` (the predictor), ``release``, ``serial`` (the unknowns
+    in scikit-fem's serial numbering).  A converged step is committed
+    (``model.commit``), checkpointed (``every``), passed to ``callback``
+    and recorded; a failed one is halved, and :class:`ConvergenceError`
+    is raised below ``options.min_step``, for fixed steps, or after
+    :data:`MAX_LOAD_STEPS` (or 4 ``steps``) attempts.  ``prev`` is the
+    predictor's ``(load, x)`` of the step before.  Returns ``(x,
+    history)``, ``x`` serial."""
     history = []
-    every = Every.of(checkpoint)
-    attempts, max_attempts = 0, max(MAX_LOAD_STEPS, 4 * steps)
+    attempts, max_attempts = 0, max(MAX_LOAD_STEPS, 4 * options.steps)
     while lam < 1.0 - 1e-14:
         attempts += 1
         if attempts > max_attempts:
             raise ConvergenceError(
                 "Newton stopped after {} load steps at load factor {:.6g} "
                 "(skfem_pg.solvers.static.MAX_LOAD_STEPS)".format(
-                    max_attempts, lam), load=lam, u=u, history=history)
+                    max_attempts, lam), load=lam, u=algebra.serial(u),
+                history=history)
         target = min(1.0, lam + dlam)
         t0 = time.perf_counter()
         start = u
-        if predictor and prev is not None:
-            start = u + (target - lam) / (lam - prev[0]) * (u - prev[1])
-        n_krylov = len(stats["iterations"])
-        ok, uk, info, state = newton_step(model, start, target, f_ext, Dd,
-                                           prescribed(target)[Dd], I, lin,
-                                           tol, maxiter, line_search)
-        info.update(load=target, seconds=time.perf_counter() - t0,
-                    krylov=stats["iterations"][n_krylov:])
-        if verbose:
-            print("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, "
-                  "min J {:.3g}".format(
-                      target, target - lam,
-                      "converged" if ok else "FAILED ({})".format(
-                          info["reason"]),
-                      len(info["residuals"]) - 1,
-                      " ".join("{:.1e}".format(r)
-                               for r in info["residuals"]),
-                      info["min_J"]), flush=True)
+        if options.predictor and prev is not None:
+            start = algebra.extrapolate(
+                u, prev[1], (target - lam) / (lam - prev[0]))
+        ok, uk, info, state = step(start, target)
+        info.update(load=target, seconds=time.perf_counter() - t0)
+        if options.verbose:
+            echo(step_line(info, target, target - lam, ok), flush=True)
         f_int = info.pop("f_int", None)
         if ok:
             if hasattr(model, "commit"):  # history of a converged step
                 model.commit(state)
+            if prev is not None:
+                algebra.release(prev[1])
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
-            if adaptive and len(info["residuals"]) <= 5:
+            if options.adaptive and len(info["residuals"]) <= 5:
                 dlam = min(2 * dlam, 1.0)
             if every is not None:  # before the callback, which may fail
                 every.save(len(history), model, u, lam, step=dlam,
@@ -234,17 +311,31 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
             if callback is not None:
                 callback(u, lam, f_int)
             continue
+        algebra.release(uk)
         dlam = (target - lam) / 2  # the step tried (clipped at 1), halved
-        if dlam < min_step or not adaptive:
-            why = ("fixed steps of {:.3g}".format(2 * dlam) if not adaptive
+        if dlam < options.min_step or not options.adaptive:
+            why = ("fixed steps of {:.3g}".format(2 * dlam)
+                   if not options.adaptive
                    else "the step fell below min_step = {:.3g}".format(
-                       min_step))
+                       options.min_step))
             raise ConvergenceError(
                 "Newton failed at load factor {:.6g} ({}); {} after "
                 "reaching load {:.6g}".format(target, info["reason"], why,
                                               lam),
-                load=lam, u=u, history=history)
-    return u, history
+                load=lam, u=algebra.serial(u), history=history)
+    return algebra.serial(u), history
+
+
+def step_line(info, load, step, ok):
+    """The progress line of a load step."""
+    return ("  load {:.4f} (step {:.4f}): {} in {} it, |r| {}, min J {:.3g}"
+            "{}".format(
+                load, step, "converged" if ok else "FAILED ({})".format(
+                    info["reason"]),
+                len(info["residuals"]) - 1,
+                " ".join("{:.1e}".format(r) for r in info["residuals"]),
+                info["min_J"], ", Krylov {}".format(info["krylov"])
+                if info.get("krylov") else ""))
 
 
 #: most load steps (converged and failed) one :func:`newton` call takes
@@ -252,7 +343,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, steps=1,
 MAX_LOAD_STEPS = 10_000
 
 
-def _check_controls(steps, tol, maxiter, min_step, load0):
+def _check_controls(steps=1, tol=1.0, maxiter=1, min_step=1.0, load0=0.0):
     """Named errors for load-stepping controls that would divide by zero,
     loop forever or run backwards."""
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) \
@@ -332,10 +423,115 @@ def verdict(res, energy, ref, tol, small=False):
 LINE_SEARCH_HALVINGS = 4
 
 
+class LinearSolveFailed(RuntimeError):
+    """A linear solve of a Newton iteration failed in a way that a shorter
+    load step may avoid (e.g. a Krylov solve diverging on an indefinite
+    tangent); its message is the iteration's ``reason``."""
+
+
+class SerialAlgebra:
+    """The linear algebra of :func:`newton_iterations` on one process:
+    NumPy vectors of all unknowns in scikit-fem's numbering, residuals and
+    solves on the free dofs ``I`` (prescribed ``Dd``) by the condensed
+    solver ``lin``.  The distributed counterpart is
+    :class:`skfem_pg.distributed.solve.PetscAlgebra`."""
+
+    def __init__(self, model=None, f_ext=None, Dd=None, I=None, lin=None):
+        self.model, self.f_ext, self.Dd, self.I, self.lin = (
+            model, f_ext, Dd, I, lin)
+
+    # vector arithmetic (load_stepping and the line search)
+    @staticmethod
+    def copy(u):
+        return u.copy()
+
+    @staticmethod
+    def add(u, du, s=1.0):
+        """``u + s du`` (``u`` may be overwritten)."""
+        if s == 1.0:
+            u += du
+            return u
+        return u + s * du
+
+    @staticmethod
+    def extrapolate(u, prev, c):
+        return u + c * (u - prev)
+
+    @staticmethod
+    def release(u):
+        pass
+
+    @staticmethod
+    def serial(u):
+        return u
+
+    # the Newton iteration
+    def increment_at_dirichlet(self, u, values):
+        """Prescribed values minus the current ones at the Dirichlet dofs,
+        and whether any is non-zero."""
+        du_D = values - u[self.Dd]
+        return du_D, bool(np.any(du_D != 0))
+
+    def state(self, u):
+        return self.model.state(u)
+
+    def min_J(self, state):
+        return self.model.min_J(state)
+
+    def residual(self, state, lam):
+        """``(r, |r_free|, f_int)`` at load factor ``lam``."""
+        f_int = self.model.internal_force(state)
+        r = f_int - lam * self.f_ext
+        return r, float(np.linalg.norm(r[self.I])), f_int
+
+    def load_norm(self, lam):
+        return lam * np.linalg.norm(self.f_ext)
+
+    def solve(self, state, u, r, du_D, first):
+        """The Newton increment (with the prescribed increment ``du_D``,
+        or ``None``) and its energy :math:`|\\Delta x\\cdot r|`; returns
+        ``(du, energy, t_assemble, t_linear)``."""
+        I, Dd = self.I, self.Dd
+        t0 = time.perf_counter()
+        K = self.model.tangent(state).tocsr()
+        t1 = time.perf_counter()
+        du = np.zeros_like(u)
+        rhs = -r[I]
+        if du_D is not None:
+            du[Dd] = du_D
+            rhs = rhs - (K @ du)[I]
+        du[I] = self.lin(submatrix(K, I), rhs)
+        return (du, abs(float(np.dot(du[I], rhs))), t1 - t0,
+                time.perf_counter() - t1)
+
+    def impose(self, u, values):
+        return u  # the increment carried the prescribed values
+
+    def small_increment(self, du, u):
+        return _small_increment(self.model, du, u)
+
+
+#: the vector arithmetic of serial unknowns (:func:`load_stepping`)
+SERIAL = SerialAlgebra()
+
+
 def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
-                 line_search=False):
-    r"""Newton iterations at load factor ``lam`` from the converged ``u``;
-    ``u_DD`` are the prescribed values at ``Dd`` at this load.
+                line_search=False):
+    """:func:`newton_iterations` on one process: ``f_ext`` the external
+    force at load factor 1, ``Dd`` the prescribed dofs and ``u_DD`` their
+    values at this load, ``I`` the free dofs, ``lin`` the condensed
+    solver."""
+    return newton_iterations(model, SerialAlgebra(model, f_ext, Dd, I, lin),
+                             u, lam, u_DD, tol, maxiter, line_search)
+
+
+def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
+                      line_search=False):
+    r"""Newton iterations at load factor ``lam`` from the converged ``u``
+    (not changed); ``prescribed`` are the values at the Dirichlet dofs at
+    this load, ``algebra`` the linear algebra (:class:`SerialAlgebra`, or
+    a partition's :class:`~skfem_pg.distributed.solve.PetscAlgebra`).
+    Returns ``(ok, x, info, state)``.
 
     The increment of the prescribed displacements enters the first linear
     solve (``K_II du_I = -r_I - K_ID du_D``), so it is spread through the
@@ -354,9 +550,8 @@ def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
     rod's first Newmark step with Unl+P1C, residuals 0.40, 0.083, 0.38,
     0.085, ....)
     """
-    u = u.copy()
-    du_D = u_DD - u[Dd]
-    pending = bool(np.any(du_D != 0))
+    u = algebra.copy(u)
+    du_D, pending = algebra.increment_at_dirichlet(u, prescribed)
     res = []
     energy = []  # |du · rhs| of each solve
     info = {"residuals": res, "energies": energy, "min_J": np.nan,
@@ -370,17 +565,15 @@ def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
         t0 = time.perf_counter()
         fail, rn = None, np.nan
         try:
-            state = model.state(u)
+            state = algebra.state(u)
         except ReturnMapError as err:  # a plastic point that cannot return
             fail = "return map: {}".format(err)
         if fail is None:
-            info["min_J"] = model.min_J(state)
+            info["min_J"] = algebra.min_J(state)
             if not info["min_J"] > 0:
                 fail = "J <= 0"
         if fail is None:
-            f_int = model.internal_force(state)
-            r = f_int - lam * f_ext
-            rn = float(np.linalg.norm(r[I]))
+            r, rn, f_int = algebra.residual(state, lam)
             if not np.isfinite(rn):
                 fail = "non-finite residual"
         info["t_assemble"] += time.perf_counter() - t0
@@ -388,7 +581,7 @@ def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
                 and (fail is not None or (len(res) >= 2 and rn > res[-1])):
             u0, du0, s = back
             back = (u0, du0, 0.5 * s)
-            u = u0 + 0.5 * s * du0
+            u = algebra.add(algebra.copy(u0), du0, 0.5 * s)
             info["backtracks"] += 1
             continue
         if fail is not None:
@@ -399,29 +592,26 @@ def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
         res.append(rn)
         if not pending:
             if ref is None:
-                ref = max(lam * np.linalg.norm(f_ext), rn, 1e-300)
+                ref = max(algebra.load_norm(lam), rn, 1e-300)
             done, info["reason"] = verdict(res, energy, ref, tol, small)
             if done is not None:
                 return done, u, info, state if done else None
         if it == maxiter:
             info["reason"] = "maxiter"
             return False, u, info, None
-        t0 = time.perf_counter()
-        K = model.tangent(state).tocsr()
-        t1 = time.perf_counter()
-        du = np.zeros_like(u)
-        rhs = -r[I]
-        if pending:
-            du[Dd] = du_D
-            rhs = rhs - (K @ du)[I]
-        du[I] = lin(submatrix(K, I), rhs)
-        energy.append(abs(float(np.dot(du[I], rhs))))
-        info["t_assemble"] += t1 - t0
-        info["t_linear"] += time.perf_counter() - t1
+        try:
+            du, e, t_asm, t_lin = algebra.solve(
+                state, u, r, du_D if pending else None, it == 0)
+        except LinearSolveFailed as err:
+            info["reason"] = str(err)
+            return False, u, info, None
+        energy.append(e)
+        info["t_assemble"] += t_asm
+        info["t_linear"] += t_lin
         if line_search and not pending and \
                 energy[-1] > ROUNDOFF_ENERGY * tol * energy[0]:
-            back = (u.copy(), du, 1.0)
-        u += du
-        small = _small_increment(model, du, u)
+            back = (algebra.copy(u), du, 1.0)
+        u = algebra.impose(algebra.add(u, du), prescribed)
+        small = algebra.small_increment(du, u)
         pending = False
         it += 1
