@@ -23,8 +23,9 @@ from . import petsc as pt
 from .comm import mpi
 from ..dofs import as_dofs
 from ..solvers.result import Result
-from ..solvers.static import (LinearSolveFailed, NewtonControls,
-                              load_stepping, newton_iterations)
+from ..solvers.controls import NewtonControls
+from ..solvers.static import (LinearSolveFailed, load_stepping,
+                              newton_iterations)
 
 
 def _dirichlet(part, D, u_D):

@@ -7,6 +7,7 @@ from .linear import (direct, linear_solver, AMGSolver, rigid_body_modes,
                      pardiso_available, DIRECT_LIMIT,
                      DIRECT_LIMIT_PARDISO, DIRECT_NNZ_LIMIT_PARDISO,
                      auto_direct_limit, submatrix)
+from .controls import NewtonControls, NewmarkControls, ExplicitControls
 from .static import newton, ConvergenceError, PG_CANDIDATES
 from .mass import lumped_mass
 from .dynamics import DynamicsError, Trajectory, EnergyBalance
@@ -20,7 +21,8 @@ from ..dofs import as_dofs
 __all__ = ["direct", "linear_solver", "AMGSolver", "rigid_body_modes",
            "pardiso_available", "DIRECT_LIMIT", "DIRECT_LIMIT_PARDISO",
            "DIRECT_NNZ_LIMIT_PARDISO",
-           "auto_direct_limit", "submatrix", "newton",
+           "auto_direct_limit", "submatrix", "newton", "NewtonControls",
+           "NewmarkControls", "ExplicitControls",
            "ConvergenceError", "PG_CANDIDATES", "as_dofs", "checkpoint",
            "lumped_mass", "DynamicsError", "Trajectory", "EnergyBalance",
            "RigidWall", "newmark", "central_difference", "stable_time_step",

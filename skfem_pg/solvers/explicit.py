@@ -45,6 +45,7 @@ from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .checkpoint import Every, load as load_checkpoint
+from .controls import ExplicitControls
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
                        Trajectory, MAX_STEPS, bind_walls, check_run, commit,
                        free_mask, history_of, history_text, stored_energy,
@@ -131,10 +132,8 @@ def stable_time_step(model, m, x=None, free=None, safety=0.8):
 
 
 def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
-                       u0=None, v0=None, dt=None, safety=0.8,
-                       estimate_every=100, wall=None, callback=None,
-                       output_every=None, max_energy_error=0.05,
-                       verbose=True, checkpoint=None, resume=None):
+                       u0=None, v0=None, dt=None, wall=None, callback=None,
+                       checkpoint=None, resume=None, controls=None, **kw):
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by central differences.
 
@@ -161,9 +160,11 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         ``callback(t, x, v, record)`` at the start, every
         ``output_every`` steps (default: about 20 outputs, guessed from
         the first step) and at the end; ``record``: the energies.
-    max_energy_error
-        Stop with :class:`DynamicsError` when the relative energy balance
-        error exceeds this (checked from step :data:`STARTUP_STEPS` on).
+    controls, **kw
+        :class:`~skfem_pg.solvers.ExplicitControls` (``safety``,
+        ``estimate_every``, ``output_every``, ``max_energy_error`` (checked
+        from step :data:`STARTUP_STEPS` on), ``verbose``), or its fields as
+        keywords (they replace the record's).
     checkpoint, resume
         A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
         ``Every("taylor.npz", seconds=600)``) to write the run's state to
@@ -181,6 +182,10 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         estimates (``estimate``), contact (``contact``) and output
         (``output``).
     """
+    c = ExplicitControls.of(controls, **kw)
+    safety, estimate_every, output_every = (c.safety, c.estimate_every,
+                                            c.output_every)
+    max_energy_error, verbose = c.max_energy_error, c.verbose
     n_u = getattr(model, "n_u", model.basis.N)
     if getattr(model, "N", n_u) != n_u:
         raise ValueError(

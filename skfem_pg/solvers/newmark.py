@@ -37,6 +37,7 @@ from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
                        Trajectory, bind_walls, check_run, commit,
                        free_mask, history_of, history_text, stored_energy,
                        time_functions)
+from .controls import NewmarkControls
 from .static import condensed_solver, newton_step
 
 
@@ -78,10 +79,8 @@ class _Inertial:
 
 
 def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
-            v0=None, beta=0.25, gamma=0.5, dt_min=None, tol=1e-8,
-            maxiter=20, solver="auto", wall=None, callback=None,
-            output_every=1, verbose=True, max_contact_passes=20,
-            line_search=False, checkpoint=None, resume=None):
+            v0=None, solver="auto", wall=None, callback=None,
+            checkpoint=None, resume=None, controls=None, **kw):
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by Newmark's method (module docstring).
 
@@ -91,16 +90,16 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         Any model of :mod:`skfem_pg.formulations` (FE or PG, mixed too).
     m
         Diagonal mass per displacement dof (:func:`lumped_mass`).
-    dt, dt_min
-        Initial (and largest) step; smallest step before giving up
-        (default ``dt / 1024``).
+    dt
+        Initial (and largest) step.
     f_ext, D, u_D
         Loads and prescribed displacements: vectors (constant) or
         callables of the time; ``D`` the prescribed dofs.
     u0, v0
         Initial displacements (or all unknowns) and velocities.
-    tol, maxiter, solver, line_search
-        Newton's method per step (:func:`~skfem_pg.solvers.newton`).
+    solver
+        The linear solver of Newton's method per step
+        (:func:`~skfem_pg.solvers.newton`).
     wall
         A :class:`~skfem_pg.solvers.RigidWall` (or a list): an active set
         of held dofs, repeated per step until it settles (at most
@@ -108,6 +107,11 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     callback
         ``callback(t, x, v, record)`` at the start and every
         ``output_every`` converged steps, and at the end.
+    controls, **kw
+        :class:`~skfem_pg.solvers.NewmarkControls` (``beta``, ``gamma``,
+        ``dt_min``, ``tol``, ``maxiter``, ``line_search``,
+        ``max_contact_passes``, ``output_every``, ``verbose``), or its
+        fields as keywords (they replace the record's).
     checkpoint, resume
         A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
         ``Every("run.npz", seconds=600)``) to write the run's state to
@@ -126,9 +130,9 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     basis = model.basis
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
+    c = NewmarkControls.of(controls, **kw)
+    beta, gamma, dt_min, verbose = c.beta, c.gamma, c.dt_min, c.verbose
     m = check_run(n_u, N, m, t_end, dt, u0, v0, dt_required=True)
-    if not (0 < beta and 0 < gamma):
-        raise ValueError("beta and gamma must be positive")
     if dt_min is not None and not (np.isfinite(dt_min)
                                    and 0 < dt_min <= dt):
         raise ValueError("dt_min must lie in (0, dt], got {!r}".format(
@@ -181,8 +185,8 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     while t < t_end * (1 - 1e-12):
         h = min(step, t_end - t)
         ok, res = _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of,
-                        walls, cand, beta, gamma, tol, maxiter, solver,
-                        solvers, times, max_contact_passes, line_search)
+                        walls, cand, beta, gamma, c.tol, c.maxiter, solver,
+                        solvers, times, c.max_contact_passes, c.line_search)
         if not ok:
             cuts += 1
             step = h / 2
@@ -208,7 +212,7 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         if len(info["residuals"]) <= 5 and step < dt:
             step = min(2 * step, dt)
         final = t >= t_end * (1 - 1e-12)
-        if steps % output_every == 0 or final:
+        if steps % c.output_every == 0 or final:
             output(info, final)
         if every is not None:
             every.save(steps, model, x, t, v=v, a=a, f_int=fi,

@@ -13,7 +13,6 @@ converged one.  A step is cut in half when Newton diverges, exceeds
 halving the increment); a :class:`ConvergenceError` names the load factor
 once the step would fall below ``min_step``.
 """
-import dataclasses
 import time
 
 import numpy as np
@@ -21,6 +20,7 @@ import numpy as np
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
+from .controls import NewtonControls, check_controls
 from .linear import linear_solver, submatrix
 from ..discretization.layout import is_family_basis
 
@@ -61,86 +61,6 @@ def condensed_solver(kind, basis, I, extra_fields=False):
                          else 0,
                          components=None if locs is None
                          else I % locs.shape[0])
-
-
-@dataclasses.dataclass(frozen=True)
-class NewtonControls:
-    r"""The controls of Newton's method with adaptive load stepping, shared
-    by :func:`newton` and the distributed
-    :func:`skfem_pg.distributed.newton` (which pass their keywords of these
-    names into one record).
-
-    Attributes
-    ----------
-    steps
-        Initial number of load steps (the step then adapts).
-    tol
-        Convergence: ``|r_free| <= tol * max(|λ f_ext|, |r_0|)`` where
-        ``r_0`` is the first residual of the step; or every field's Newton
-        increment below ``1e-10`` of its magnitude; or the energy of the
-        last increment :math:`|\Delta x\cdot r|` below ``tol²`` times
-        that of the first (a measure in units of work, whatever the
-        fields: with pressures and dilatations as unknowns the residual
-        norm mixes units); or, once the residual stops decreasing (its
-        round-off floor, set by the bulk modulus and not by the load),
-        that energy below ``ROUNDOFF_ENERGY · tol`` times the first
-        (the history's ``reason`` then says "round-off floor").
-    maxiter
-        Newton iterations per load step at most.
-    min_step
-        The smallest load step: a step that would be cut below it raises
-        :class:`ConvergenceError`.
-    adaptive
-        ``True``: a step that converges in at most 4 iterations doubles
-        the next one, a failed step is halved (down to ``min_step``).
-        ``False``: ``steps`` equal steps, and a failed one raises
-        :class:`ConvergenceError` at once (robustness studies: the largest
-        step that converges).
-    predictor
-        Start each load step from the linear extrapolation of the last two
-        converged states (secant predictor) instead of the last one; a
-        step that fails from it is cut like any other.
-    line_search
-        ``True``: halve an increment whose iterate fails, or a later
-        one that raises the residual (at most
-        :data:`LINE_SEARCH_HALVINGS` times), before the step counts as
-        failed (:func:`newton_iterations`).  ``False``: full Newton
-        increments, a failed iterate cuts the step.
-    verbose
-        Print a line per load step (on rank 0 of a distributed run).
-    """
-
-    steps: int = 1
-    tol: float = 1e-9
-    maxiter: int = 25
-    min_step: float = 1.0 / 1024
-    adaptive: bool = True
-    predictor: bool = True
-    line_search: bool = False
-    verbose: bool = True
-
-    def __post_init__(self):
-        _check_controls(steps=self.steps, tol=self.tol, maxiter=self.maxiter,
-                        min_step=self.min_step)
-
-    @classmethod
-    def of(cls, controls=None, defaults=None, **kw):
-        """``controls`` (a record) with ``kw`` (keywords of its field
-        names) replacing fields; ``defaults`` the keywords a driver's
-        record starts from.  An unknown keyword raises ``TypeError``
-        naming it."""
-        known = {f.name for f in dataclasses.fields(cls)}
-        bad = sorted(set(kw) - known)
-        if bad:
-            raise TypeError("unknown Newton control(s) {}: the controls "
-                            "are {}".format(", ".join(bad),
-                                            ", ".join(sorted(known))))
-        if controls is None:
-            controls = cls(**(defaults or {}))
-        elif not isinstance(controls, cls):
-            raise TypeError("controls must be a NewtonControls, got {}"
-                            .format(type(controls).__name__))
-        return dataclasses.replace(controls, **kw) if kw else controls
 
 
 def newton(model, f_ext=None, D=None, u_D=None, u0=None, solver="auto",
@@ -208,7 +128,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, solver="auto",
 
     """
     opts = NewtonControls.of(controls, **kw)
-    _check_controls(load0=load0)
+    check_controls(load0=load0)
     basis = model.basis
     N = getattr(model, "N", basis.N)
     n_u = getattr(model, "n_u", N)
@@ -341,27 +261,6 @@ def step_line(info, load, step, ok):
 #: most load steps (converged and failed) one :func:`newton` call takes
 #: (or 4 ``steps``): no input makes the load loop run forever
 MAX_LOAD_STEPS = 10_000
-
-
-def _check_controls(steps=1, tol=1.0, maxiter=1, min_step=1.0, load0=0.0):
-    """Named errors for load-stepping controls that would divide by zero,
-    loop forever or run backwards."""
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) \
-            or steps < 1:
-        raise ValueError("steps must be a positive integer, got {!r}"
-                         .format(steps))
-    if isinstance(maxiter, bool) \
-            or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
-        raise ValueError("maxiter must be a positive integer, got {!r}"
-                         .format(maxiter))
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError("tol must be a positive number, got {!r}"
-                         .format(tol))
-    if not (np.isfinite(min_step) and 0 < min_step <= 1):
-        raise ValueError("min_step must lie in (0, 1], got {!r}: the step "
-                         "halving needs a floor".format(min_step))
-    if not (np.isfinite(load0) and 0.0 <= load0 <= 1.0):
-        raise ValueError("load0 must lie in [0, 1], got {!r}".format(load0))
 
 
 def padded_vector(v, n_u, N, what, rest=None):

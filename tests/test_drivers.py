@@ -1,0 +1,103 @@
+"""One load-stepping driver and the drivers' option records: the serial
+and distributed Newton share load_stepping / newton_iterations (the linear
+algebra injected), and every driver takes its controls as one record or as
+keywords of the record's fields."""
+import numpy as np
+import pytest
+import skfem as fem
+
+import skfem_pg as pg
+from skfem_pg import materials as mat
+from skfem_pg.formulations import Hyperelastic
+from skfem_pg.solvers import (ExplicitControls, NewmarkControls,
+                              NewtonControls, central_difference,
+                              lumped_mass, newmark, newton)
+from skfem_pg.solvers import static
+
+
+@pytest.fixture(scope="module")
+def beam():
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 4, 9),
+                                    np.linspace(0, 1, 3))
+    mesh = mesh.with_boundaries({"left": lambda x: np.isclose(x[0], 0),
+                                 "right": lambda x: np.isclose(x[0], 4)})
+    b = pg.FamilyBasis(mesh, dim=2)
+    return b, pg.traction(b, "right", [0.0, 0.02]), b.get_dofs("left")
+
+
+def test_record_and_keywords_are_the_same_run(beam):
+    b, f, D = beam
+    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    c = NewtonControls(steps=2, tol=1e-11, predictor=False, verbose=False)
+    x1, h1 = newton(model, f, D=D, controls=c)
+    x2, h2 = newton(model, f, D=D, steps=2, tol=1e-11, predictor=False,
+                    verbose=False)
+    x3, h3 = newton(model, f, D=D, controls=c, steps=1)  # keyword wins
+    assert np.array_equal(x1, x2) and len(h1) == len(h2) == 2
+    assert len(h3) == 1 and np.allclose(x3, x1, atol=1e-9 * abs(x1).max())
+
+
+def test_controls_are_checked_by_name():
+    with pytest.raises(TypeError, match="tolerance.*NewtonControls"):
+        NewtonControls.of(tolerance=1e-9)
+    with pytest.raises(ValueError, match="tol must be a positive"):
+        NewtonControls(tol=-1.0)
+    with pytest.raises(ValueError, match="min_step"):
+        NewtonControls(min_step=0.0)
+    with pytest.raises(TypeError, match="controls must be a NewmarkControls"):
+        NewmarkControls.of(NewtonControls())
+    with pytest.raises(ValueError, match="beta and gamma"):
+        NewmarkControls(beta=0.0)
+    with pytest.raises(ValueError, match="output_every"):
+        NewmarkControls(output_every=0)
+    with pytest.raises(ValueError, match="safety"):
+        ExplicitControls(safety=-0.5)
+    with pytest.raises(ValueError, match="estimate_every"):
+        ExplicitControls(estimate_every=2.5)
+
+
+def test_the_linear_algebra_is_injected(beam):
+    """load_stepping + newton_iterations with a wrapped SerialAlgebra (what
+    the distributed Newton does with PETSc's): the same answer as newton,
+    and every solve went through the injected object."""
+    b, f, D = beam
+    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    x_ref, _ = newton(model, f, D=D, steps=2, verbose=False)
+    Dd = np.asarray(D.flatten())
+    I = np.setdiff1d(np.arange(b.N), Dd)
+    lin = static.condensed_solver("direct", b, I)
+    solves = []
+
+    class Counting(static.SerialAlgebra):
+        def solve(self, *args):
+            solves.append(1)
+            return super().solve(*args)
+
+    algebra = Counting(model, f, Dd, I, lin)
+    c = NewtonControls(steps=2, verbose=False)
+
+    def step(start, target):
+        return static.newton_iterations(model, algebra, start, target,
+                                        np.zeros(len(Dd)), c.tol, c.maxiter)
+
+    x, hist = static.load_stepping(model, step, algebra, np.zeros(b.N), 0.0,
+                                   0.5, c)
+    assert np.allclose(x, x_ref, rtol=0, atol=1e-12 * abs(x_ref).max())
+    assert len(solves) == sum(len(h["residuals"]) - 1 for h in hist) > 0
+
+
+def test_dynamics_take_their_records(beam):
+    b, f, D = beam
+    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    m = lumped_mass(b, 1.0)
+    a = newmark(model, m, 0.2, 0.05, f_ext=f, D=D,
+                controls=NewmarkControls(output_every=2, verbose=False))
+    k = newmark(model, m, 0.2, 0.05, f_ext=f, D=D, output_every=2,
+                verbose=False)
+    assert np.array_equal(a.x, k.x) and len(a.history) == 3
+    e = central_difference(model, m, 0.05, f_ext=f, D=D,
+                           controls=ExplicitControls(safety=0.5,
+                                                     verbose=False))
+    k = central_difference(model, m, 0.05, f_ext=f, D=D, safety=0.5,
+                           verbose=False)
+    assert np.array_equal(e.x, k.x) and e.steps == k.steps > 1
