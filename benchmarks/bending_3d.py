@@ -28,7 +28,6 @@ and regular hexahedral grids split into tetrahedra (``--grids``), distorted by
     python benchmarks/bending_3d.py [--sizes 5 3.5 2.5 2] [--grids 8 12 16]
 """
 import os
-import sys
 import time
 import warnings
 
@@ -36,17 +35,16 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
+from harness import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.scene import _transfer_boundaries
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(os.path.dirname(HERE), "demos"))
-from cook_3d import CORNER, T, cook3d  # noqa: E402
+T = 10.0  # the thickness of pg.meshing.cook_membrane_3d
+CORNER = (48.0, 60.0, T)
 
 RESULTS = os.path.join(HERE, "README.md")  # measured tables, written here
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
@@ -181,9 +179,9 @@ def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
     sets = [("gmsh size {}".format(s), pg.meshing.from_geo(geo, size=s))
             for s in sizes]
     for n in grids:
-        h = cook3d(n, max(1, n // 4), 0.3, seed=n)
+        h = pg.meshing.cook_membrane_3d(n, max(1, n // 4), T, 0.3, seed=n)
         sets.append(("hex {}x{}x{} split, ±0.3h".format(n, n, n // 4),
-                     _transfer_boundaries(h, h.to_meshtet())))
+                     pg.meshing.transfer_boundaries(h, h.to_meshtet())))
     # a linear field is captured exactly by every method (consistency)
     b = pg.FamilyBasis(sets[0][1], dim=3)
     grad = np.array([[0.1, 0.3, -0.2], [0.2, 0.4, 0.1], [-0.1, 0.05, 0.3]])
@@ -193,7 +191,7 @@ def main(sizes=(5, 3.5, 2.5, 2.0), grids=(8, 12, 16)):
     print("linear field, VC PBG Unl on {} nodes: energy ratio - 1 = "
           "{:.1e}".format(sets[0][1].nvertices, lin - 1))
     energy_table(sets)
-    ref = scene(cook3d(16, 4)).solve("H2")
+    ref = scene(pg.meshing.cook_membrane_3d(16, 4, T)).solve("H2")
     rows = cook_table(sizes, ref.probes["corner"][2])
     print("updated", update_results(
         RESULTS, "bending_3d_linear_cook",

@@ -25,7 +25,7 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.infsup import infsup_fe, infsup_mixed, infsup_pg
 from skfem_pg.formulations import MeanDilatation, NodalPressure
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+from harness import (demo_parser, markdown_table,
                                        output_dir, save_figure,
                                        update_results)
 

@@ -20,7 +20,7 @@ import subprocess
 import sys
 import tempfile
 
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+from harness import (demo_parser, markdown_table,
                                        update_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))

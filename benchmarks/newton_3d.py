@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
+from harness import (demo_parser, markdown_table, output_dir,
                                 update_results)
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),

@@ -21,7 +21,7 @@ import skfem as fem
 import skfem_pg as pg
 from skfem_pg.formulations.by_name import model_for
 from skfem_pg.materials import J2Plasticity
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+from harness import (demo_parser, markdown_table,
                                        update_results)
 from skfem_pg.solvers import linear_solver
 

@@ -32,7 +32,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.formulations import linear_elasticity
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+from harness import (demo_parser, markdown_table,
                                        update_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -94,7 +94,7 @@ def peak_gb():
 
 
 def main():
-    from skfem_pg.scenes.reporting import demo_parser, markdown_table, \
+    from harness import demo_parser, markdown_table, \
         update_results
     import skfem_pg as pg
     p = demo_parser(__doc__)

@@ -37,7 +37,7 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes.reference import overkill
-from skfem_pg.scenes.reporting import (demo_parser, first_within,
+from harness import (demo_parser, first_within,
                                        markdown_table,
                                        new_figure, output_dir,
                                        plot_error_vs_time, save_figure,

@@ -33,7 +33,7 @@ from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.reference import overkill
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table,
+from harness import (demo_parser, markdown_table,
                                        output_dir, print_time_to_target,
                                        save_error_vs_time, update_results,
                                        wall_time)

@@ -25,11 +25,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
 from skfem_pg.scenes.reference import linear_cook
-from skfem_pg.scenes.reporting import plot_error_vs_time
+from harness import plot_error_vs_time
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 POINT = np.array([48.0, 52.0])

@@ -34,7 +34,7 @@ import skfem_pg as pg
 from skfem_pg import distributed as dist
 from skfem_pg import materials as mat
 from skfem_pg.formulations import Hyperelastic
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 
 MATERIAL = mat.NeoHookeIsoVol.from_lame(100.0, 40.0)
 CORNER = (48.0, 60.0, 10.0)

@@ -21,7 +21,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity

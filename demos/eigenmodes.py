@@ -20,8 +20,8 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
-from skfem_pg.scenes.reporting import save_figure
+from harness import demo_parser, output_dir
+from harness import save_figure
 from skfem_pg.materials import lame
 from skfem_pg.formulations import U1SIG, U1SUnl, linear_elasticity
 from skfem_pg.analysis.spectrum import classify, free_modes

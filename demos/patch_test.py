@@ -16,7 +16,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 from skfem_pg.analysis import linear_patch_test
 from skfem_pg.naming import parse
 

@@ -24,7 +24,7 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 from skfem_pg.solvers import newton
 
 A, B, U_A = 1.0, 2.0, 0.01

@@ -36,7 +36,7 @@ from skfem_pg.materials import lame
 from skfem_pg.dofs import check_sliding
 from skfem_pg.formulations import linear_elasticity
 from skfem_pg.scenes.reference import overkill
-from skfem_pg.scenes.reporting import (demo_parser, markdown_table, output_dir,
+from harness import (demo_parser, markdown_table, output_dir,
                                 update_results)
 from skfem_pg.scenes import Scene
 

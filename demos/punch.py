@@ -26,11 +26,11 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
+from harness import demo_parser, output_dir
 from skfem_pg import materials as mat
 from skfem_pg.formulations import Hyperelastic
 from skfem_pg.discretization.particles import inverted_cells
-from skfem_pg.scenes.reporting import markdown_table, update_results
+from harness import markdown_table, update_results
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.solvers import newton, ConvergenceError
 

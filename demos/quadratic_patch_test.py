@@ -25,8 +25,8 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.naming import parse
-from skfem_pg.scenes.reporting import demo_parser, output_dir
-from skfem_pg.scenes.reporting import save_figure
+from harness import demo_parser, output_dir
+from harness import save_figure
 from skfem_pg.analysis import quadratic_patch_test
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out

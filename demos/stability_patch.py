@@ -26,8 +26,8 @@ import numpy as np
 import scipy.sparse.linalg as spl
 
 import skfem_pg as pg
-from skfem_pg.scenes.reporting import demo_parser, output_dir
-from skfem_pg.scenes.reporting import save_figure
+from harness import demo_parser, output_dir
+from harness import save_figure
 from skfem_pg import materials as mat
 from skfem_pg.formulations import Hyperelastic
 from skfem_pg.materials import lame

@@ -19,7 +19,7 @@ from . import (discretization, formulations, materials, solvers, analysis,
                scenes, threads, errors, registry)
 from .discretization import (particles, families, shape, corrections,
                              loads)
-from .scenes import meshing, reference, reporting
+from .scenes import meshing, reference
 from .errors import (ParticleError, FamilyError, CorrectionError,
                      UnsupportedMeshError, SlowAssemblyWarning)
 from .discretization import (Particles, Families, FamilyBasis, assemble,

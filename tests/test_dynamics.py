@@ -113,6 +113,7 @@ def test_newmark_conserves_a_linear_problems_energy_exactly():
     assert np.abs(tr.series("relative_error")).max() < 1e-10
 
 
+@pytest.mark.study
 @pytest.mark.parametrize("method", ["explicit", "newmark"])
 def test_wave_arrival_time(method):
     """A velocity prescribed at one end of a long bar: the particle

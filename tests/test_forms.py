@@ -161,6 +161,7 @@ def ex43_mesh():
             'left': lambda x: x[0] == 0., 'right': lambda x: x[0] == 1.})
 
 
+@pytest.mark.slow
 def test_ex43_with_family_basis(ex43_mesh):
     """ex43 with ``Basis`` swapped for ``FamilyBasis`` and the forms
     imported from skfem_pg: u.max 0.25391 (FE H1: 0.24666), every load

@@ -326,6 +326,7 @@ def test_bubble_recovers_from_a_bad_warm_start():
         assert np.abs(s["F"] - good["F"]).max() < 1e-10
 
 
+@pytest.mark.study
 @pytest.mark.parametrize("name,tets", [
     ("FEM H1P0", False), ("VCPBG V3m U1SIG", False),
     # on the same nodes split into tetrahedra, with the kNN recipe (the

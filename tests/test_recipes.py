@@ -91,6 +91,7 @@ def test_exactly_the_rigid_body_zero_modes(dim):
     assert pgev[rigid] > 0.5 * feev[rigid]
 
 
+@pytest.mark.study
 def test_manufactured_rates_3d():
     """L2 and H1 rates on unstructured gmsh tetrahedra (144 ... 1879
     nodes; measured 2.17 and 1.27)."""

@@ -146,16 +146,3 @@ def test_check_sliding_names_the_particle():
         check_sliding(sn, 2 * bottom + 1)
     check_sliding(sn, np.concatenate([2 * bottom, 2 * bottom + 1]))
     check_sliding(pg.FamilyBasis(mesh, dim=2), 2 * bottom + 1)
-
-
-def test_time_to_target_waits_until_the_error_stays_there():
-    """``first_within``: a method whose error crosses the target on its
-    way (and leaves it again) has not reached it until it stays."""
-    from skfem_pg.scenes.reporting import first_within
-    rows = [dict(method="a", nodes=n, err=e) for n, e in
-            ((10, 0.05), (20, 0.009), (40, 0.02), (80, 0.008), (160, 0.004))]
-    rows.append(dict(method="b", nodes=10, err=0.5))
-    assert first_within(rows, "a", 0.01)["nodes"] == 80
-    assert first_within(rows, "a", 0.001) is None
-    assert first_within(rows, "b", 0.01) is None
-    assert first_within(rows, "c", 0.01) is None

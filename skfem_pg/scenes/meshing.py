@@ -271,6 +271,21 @@ def taylor_rod(n=1, length=TAYLOR_ROD["length"],
         "top": lambda x: np.isclose(x[0], length), **names})
 
 
+def transfer_boundaries(old, new):
+    """Named boundaries of ``old`` on ``new``, a split of ``old`` with the
+    same vertices: a boundary facet of ``new`` belongs to a name when all
+    its vertices lie on that name's facets."""
+    if not old.boundaries:
+        return new
+    bfacets = new.boundary_facets()
+    named = {}
+    for name, facets in old.boundaries.items():
+        on = np.zeros(old.nvertices, dtype=bool)
+        on[old.facets[:, facets].ravel()] = True
+        named[name] = bfacets[np.all(on[new.facets[:, bfacets]], axis=0)]
+    return new.with_boundaries(named)
+
+
 def tetrahedra(mesh):
     """The hexahedral ``mesh`` split into tetrahedra on the same nodes
     (scikit-fem's ``to_meshtet``), its named boundaries carried over: a

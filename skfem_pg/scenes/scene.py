@@ -50,7 +50,7 @@ from ..solvers import newton
 from ..solvers.result import Result
 from .. import distributed, registry
 from ..distributed.solve import DistributedResult
-from .meshing import point_index
+from .meshing import point_index, transfer_boundaries
 
 
 class Scene:
@@ -190,9 +190,9 @@ class Scene:
         if isinstance(mesh, need):
             return mesh
         if need is fem.MeshTri1 and isinstance(mesh, fem.MeshQuad1):
-            return _transfer_boundaries(mesh, mesh.to_meshtri())
+            return transfer_boundaries(mesh, mesh.to_meshtri())
         if need is fem.MeshTet1 and isinstance(mesh, fem.MeshHex1):
-            return _transfer_boundaries(mesh, mesh.to_meshtet())
+            return transfer_boundaries(mesh, mesh.to_meshtet())
         raise ValueError("{} needs a {} node set, the scene has a {}".format(
             method, need.__name__, type(mesh).__name__))
 
@@ -440,18 +440,3 @@ def inside(mesh, x, tree=None):
     x = np.asarray(x, float)
     _, i = tree.query(x.T)
     return x + 1e-8 * (tree.data[i].T - x)
-
-
-def _transfer_boundaries(old, new):
-    """Named boundaries of ``old`` on ``new``, a split of ``old`` with the
-    same vertices: a boundary facet of ``new`` belongs to a name when all
-    its vertices lie on that name's facets."""
-    if not old.boundaries:
-        return new
-    bfacets = new.boundary_facets()
-    named = {}
-    for name, facets in old.boundaries.items():
-        on = np.zeros(old.nvertices, dtype=bool)
-        on[old.facets[:, facets].ravel()] = True
-        named[name] = bfacets[np.all(on[new.facets[:, bfacets]], axis=0)]
-    return new.with_boundaries(named)

@@ -1,4 +1,10 @@
-"""Reporting benchmark runs: wall time and error-against-time plots.
+"""The harness of the demos and benchmarks (not part of the package):
+their command line (``--out``, ``--quick``, ``--results``), where they
+write, the measured tables they write into ``benchmarks/README.md``,
+wall time to an accuracy and error-against-time plots.
+
+A demo imports it as ``harness`` (``python demos/NAME.py`` puts this
+folder on ``sys.path``); the benchmarks through ``benchmarks/harness.py``.
 
 A *row* is a dict with at least ``method``, ``err`` and the time split
 ``preprocess``, ``assemble``, ``solve`` (as in
@@ -6,7 +12,7 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 """
 import os
 
-from .. import threads
+from skfem_pg import threads
 
 
 def output_dir(path=None, create=True):
