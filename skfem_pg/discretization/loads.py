@@ -61,6 +61,34 @@ def warn_if_zero(values, what):
                       "load is applied".format(what), stacklevel=3)
 
 
+def fe_traction(basis, facets, t, what="traction t", mesh=None):
+    r""":math:`f_i = \int_\Gamma N_i\, t\, d\Gamma` on ``facets`` (indices
+    or a boundary name) of a scikit-fem cell basis, by its element's facet
+    basis on ``mesh`` (default ``basis.mesh``); ``t`` as in
+    :func:`traction`."""
+    if not isinstance(basis, fem.CellBasis):
+        raise TypeError("a traction needs a FamilyBasis or a scikit-fem "
+                        "CellBasis, got {}".format(type(basis).__name__))
+    nc = basis.elem.dim if isinstance(basis.elem, fem.ElementVector) \
+        else None
+    fb = fem.FacetBasis(basis.mesh if mesh is None else mesh, basis.elem,
+                        facets=facets)
+    if callable(t):
+        warn_if_zero(call_user(t, fb.global_coordinates(), what), what)
+    else:
+        t = _constant_of(t, nc, what)
+
+    def load(v, w):
+        tv = call_user(t, w.x, what) if callable(t) else t
+        if nc is None:
+            return tv * v
+        tv = np.asarray(tv, dtype=float)
+        if tv.ndim == 1:
+            tv = tv[:, None, None]
+        return sum(tv[a] * v[a] for a in range(nc))
+    return fem.LinearForm(load).assemble(fb)
+
+
 def _facet_basis(basis, facets, what):
     p = basis.particles
     if p.kind != "vertices":
@@ -71,13 +99,17 @@ def _facet_basis(basis, facets, what):
 
 
 def traction(basis, facets, t):
-    r"""Consistent nodal forces of a traction ``t`` on ``facets``.
+    r"""Consistent nodal forces of a traction ``t`` on ``facets``, on a
+    :class:`~skfem_pg.FamilyBasis` or a scikit-fem cell basis
+    (:func:`fe_traction`).
 
     ``t``: constant vector (scalar for a scalar basis) or a callable of the
     facet quadrature points ``x`` (shape ``(dim, nfacets, nqp)``) returning
     an array of shape ``(dim, nfacets, nqp)``.  Returns a length-``N``
     vector.
     """
+    if not is_family_basis(basis):
+        return fe_traction(basis, facets, t)
     fb = _facet_basis(basis, facets, "traction")
     vector = basis.ncomp is not None
     # the facet basis is local (Particles.facet_origin); t sees global x
@@ -192,8 +224,11 @@ def body_force(basis, b, rho=1.0):
 
 def _constant(t, basis, what):
     """A constant load as a float array of the basis' component count."""
+    return _constant_of(t, basis.ncomp, what)
+
+
+def _constant_of(t, nc, what):
     t = np.asarray(t, dtype=float)
-    nc = basis.ncomp
     if nc is None:
         if t.size != 1:
             raise ValueError("{} on a scalar basis must be a scalar, got "

@@ -40,8 +40,8 @@ import numpy as np
 import skfem as fem
 
 from ..discretization.basis import FamilyBasis
-from ..discretization.loads import (call_user, traction as pg_traction,
-                                    warn_if_zero)
+from ..discretization.loads import (call_user, fe_traction,
+                                    traction as pg_traction)
 from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
 from ..formulations.updated_lagrange import UpdatedLagrange
@@ -235,23 +235,9 @@ class Scene:
         return D, u_D
 
     def _fe_traction(self, basis, mesh, name, t):
-        fb = fem.FacetBasis(mesh, basis.elem, facets=name)
-        if not callable(t):
-            t = np.asarray(t, float)
-            if t.shape != (self.dim,):
-                raise ValueError("traction on {!r} must have {} components, "
-                                 "got shape {}".format(name, self.dim,
-                                                       t.shape))
-
-        what = "the traction t(x) on {!r}".format(name)
-        if callable(t):
-            warn_if_zero(call_user(t, fb.global_coordinates(), what), what)
-
-        def load(v, w):
-            tv = call_user(t, w.x, what) if callable(t) \
-                else t[:, None, None]
-            return sum(tv[a] * v[a] for a in range(self.dim))
-        return fem.LinearForm(load).assemble(fb)
+        what = "the traction t(x) on {!r}" if callable(t) \
+            else "traction on {!r}"
+        return fe_traction(basis, name, t, mesh=mesh, what=what.format(name))
 
     # -- solving -------------------------------------------------------
     def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
