@@ -19,8 +19,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from harness import (demo_parser, markdown_table, output_dir,
-                                update_results)
+from harness import (demo_parser, markdown_table, output_dir, update_results)
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
 

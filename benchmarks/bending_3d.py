@@ -35,8 +35,7 @@ import numpy as np
 import skfem as fem
 
 import skfem_pg as pg
-from harness import (demo_parser, markdown_table, output_dir,
-                                update_results)
+from harness import (demo_parser, markdown_table, output_dir, update_results)
 from skfem_pg import families as families_mod
 from skfem_pg import materials as mat
 from skfem_pg.analysis import energy_capture

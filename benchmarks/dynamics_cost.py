@@ -23,8 +23,7 @@ import numpy as np
 
 import skfem_pg as pg
 from skfem_pg.scenes import Scene
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 from skfem_pg.solvers import (RigidWall, central_difference, linear_solver,
                               lumped_mass, newmark, stable_time_step)
 

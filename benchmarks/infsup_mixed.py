@@ -25,9 +25,8 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.infsup import infsup_fe, infsup_mixed, infsup_pg
 from skfem_pg.formulations import MeanDilatation, NodalPressure
-from harness import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+from harness import (demo_parser, markdown_table, output_dir, save_figure,
+                     update_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "README.md")

@@ -29,8 +29,7 @@ import skfem as fem
 import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.formulations.by_name import model_for
-from harness import demo_parser, markdown_table, \
-    update_results
+from harness import (demo_parser, markdown_table, update_results)
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")

@@ -20,8 +20,7 @@ import subprocess
 import sys
 import tempfile
 
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 DEMO = os.path.join(HERE, os.pardir, "demos", "cook_mpi.py")

@@ -19,8 +19,7 @@ import time
 import numpy as np
 
 import skfem_pg as pg
-from harness import (demo_parser, markdown_table, output_dir,
-                                update_results)
+from harness import (demo_parser, markdown_table, output_dir, update_results)
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")

@@ -21,8 +21,7 @@ import skfem as fem
 import skfem_pg as pg
 from skfem_pg.formulations.by_name import model_for
 from skfem_pg.materials import J2Plasticity
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 from skfem_pg.solvers import linear_solver
 
 STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,

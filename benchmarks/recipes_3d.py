@@ -32,8 +32,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.formulations import linear_elasticity
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "README.md")

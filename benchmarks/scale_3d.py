@@ -94,8 +94,7 @@ def peak_gb():
 
 
 def main():
-    from harness import demo_parser, markdown_table, \
-        update_results
+    from harness import (demo_parser, markdown_table, update_results)
     import skfem_pg as pg
     p = demo_parser(__doc__)
     p.add_argument("--sizes", type=float, nargs="*",

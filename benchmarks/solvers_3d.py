@@ -31,8 +31,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.formulations import linear_elasticity
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 from skfem_pg.solvers.linear import AMGSolver, direct, pardiso_available
 from skfem_pg.solvers.static import PG_CANDIDATES
 

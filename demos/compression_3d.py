@@ -32,8 +32,7 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.discretization.particles import inverted_cells
 from skfem_pg.scenes import Scene
-from harness import (demo_parser, markdown_table,
-                                       update_results)
+from harness import (demo_parser, markdown_table, update_results)
 from skfem_pg.solvers import ConvergenceError, newton
 
 MATERIAL = mat.NeoHookeIsoVol(1.0, 2.0)

@@ -37,11 +37,9 @@ import skfem_pg as pg
 from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes.reference import overkill
-from harness import (demo_parser, first_within,
-                                       markdown_table,
-                                       new_figure, output_dir,
-                                       plot_error_vs_time, save_figure,
-                                       update_results, wall_time)
+from harness import (demo_parser, first_within, markdown_table, new_figure,
+                     output_dir, plot_error_vs_time, save_figure,
+                     update_results, wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out

@@ -35,9 +35,8 @@ import skfem_pg as pg
 from skfem_pg.materials import NeoHooke
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries
-from harness import (demo_parser, markdown_table,
-                                       new_figure, output_dir,
-                                       save_figure, update_results)
+from harness import (demo_parser, markdown_table, new_figure, output_dir,
+                     save_figure, update_results)
 from skfem_pg.solvers import DynamicsError, lumped_mass, newmark
 
 E, NU, RHO = 210.0, 0.3, 7.85

@@ -33,10 +33,9 @@ from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.reference import overkill
-from harness import (demo_parser, markdown_table,
-                                       output_dir, print_time_to_target,
-                                       save_error_vs_time, update_results,
-                                       wall_time)
+from harness import (demo_parser, markdown_table, output_dir,
+                     print_time_to_target, save_error_vs_time, update_results,
+                     wall_time)
 
 G, LAM = 0.375, 7.5e6
 MATERIAL = mat.NeoHookeIsoVol(G, LAM + 2.0 * G / 3.0)

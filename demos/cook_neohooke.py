@@ -33,8 +33,8 @@ from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.scenes.reference import overkill
 from harness import (demo_parser, markdown_table, output_dir,
-                                print_time_to_target, save_error_vs_time,
-                                update_results, wall_time)
+                     print_time_to_target, save_error_vs_time, update_results,
+                     wall_time)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out

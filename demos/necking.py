@@ -58,9 +58,8 @@ from skfem_pg.materials import J2Plasticity
 from skfem_pg.naming import knn_name
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.io import VTUSeries, step_writer
-from harness import (demo_parser, markdown_table,
-                                       new_figure, output_dir,
-                                       save_figure, update_results)
+from harness import (demo_parser, markdown_table, new_figure, output_dir,
+                     save_figure, update_results)
 from skfem_pg.solvers import ConvergenceError, newton
 
 STEEL = J2Plasticity.from_young(206.9, 0.29, 0.45, H=0.13, sigma_yinf=1.165,

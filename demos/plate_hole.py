@@ -36,8 +36,7 @@ from skfem_pg.materials import lame
 from skfem_pg.dofs import check_sliding
 from skfem_pg.formulations import linear_elasticity
 from skfem_pg.scenes.reference import overkill
-from harness import (demo_parser, markdown_table, output_dir,
-                                update_results)
+from harness import (demo_parser, markdown_table, output_dir, update_results)
 from skfem_pg.scenes import Scene
 
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out

@@ -41,9 +41,8 @@ from skfem_pg.analysis.postprocess import particle_fields
 from skfem_pg.discretization.particles import inverted_cells
 from skfem_pg.scenes import Scene
 from skfem_pg.scenes.reference import overkill
-from harness import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results, wall_time)
+from harness import (demo_parser, markdown_table, output_dir, save_figure,
+                     update_results, wall_time)
 from skfem_pg.solvers import ConvergenceError
 
 E, Q = 4.8293, 9.0

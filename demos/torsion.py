@@ -38,9 +38,8 @@ from skfem_pg import materials as mat
 from skfem_pg.analysis.postprocess import (cauchy_and_von_mises,
                                           particle_fields)
 from skfem_pg.scenes import Scene
-from harness import (demo_parser, markdown_table,
-                                       output_dir, save_figure,
-                                       update_results)
+from harness import (demo_parser, markdown_table, output_dir, save_figure,
+                     update_results)
 from skfem_pg.solvers import ConvergenceError, newton
 
 A, L = 1e-3, 5e-3

@@ -162,6 +162,13 @@ def _torsion(out):
     assert int(rows["PBG Unl (VCPBG Unl)"][0]) > int(rows["FEM H1 (H1)"][0])
 
 
+def _torsion_dynamic(out):
+    rows = _table_rows(out)  # both reach 90 degrees on either node set
+    for name in ("VCPBG U1SIG", "FEM H1P0"):
+        ep, _, angle = rows[name][:3]
+        assert float(ep) > 0 and angle == ">= 90"
+
+
 def _taylor(out):
     rows = _table_rows(out)
     pg_, fe = rows["VCPBG Unl"], rows["FEM H1"]
@@ -176,6 +183,7 @@ CHECKS = {
     "necking.py": (_necking, "necking.png"),
     "torsion.py": (_torsion, "torsion.png"),
     "taylor.py": (_taylor, "taylor.png"),
+    "torsion_dynamic.py": (_torsion_dynamic, "torsion_dynamic.png"),
     "cook_3d.py": (_cook_3d, "cook_3d.png"),
     "punch_3d.py": (_punch_3d, "punch_3d.png"),
     "cook_incompressible.py": (_cook_incompressible,

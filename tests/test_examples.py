@@ -18,6 +18,7 @@ def run(name, tmp_path):
     out = subprocess.run([sys.executable, os.path.join(EXAMPLES, name)],
                          capture_output=True, text=True, timeout=600,
                          env={**os.environ, "SKFEM_PG_OUT": str(tmp_path),
+                              "SKFEM_PG_CACHE": str(tmp_path / "cache"),
                               "MPLBACKEND": "Agg"})
     assert out.returncode == 0, out.stderr[-2000:]
     assert os.path.exists(tmp_path / name.replace(".py", ".png"))
