@@ -482,22 +482,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     G_corrected, VCReport
 
     """
-    if variant not in ("V1", "V2", "V3", "V4", "V5"):
-        raise ValueError("VC variant {!r} is not available (V1, V2, V3, "
-                         "V4, V5; second order: skfem_pg.discretization.vc2)"
-                         .format(variant))
-    if boundary not in BOUNDARY_VARIANTS:
-        raise ValueError("VC boundary variant {!r} is not available: use "
-                         "one of {}".format(boundary,
-                                            ", ".join(BOUNDARY_VARIANTS)))
-    if boundary != "min-norm" and exclude is not None:
-        raise ValueError("vc_exclude is for the minimum-norm solve; the "
-                         "boundary variants 'p', 's', 'sn' choose the "
-                         "released constraints themselves")
-    if boundary == "p" and variant not in ("V3", "V5"):
-        raise ValueError("boundary variant 'p' pins the d + d² linear "
-                         "modes of V3/V5; {} has others: use 's' or 'sn'"
-                         .format(variant))
+    _check_vc_options(variant, boundary, exclude)
     grouped = isinstance(G, (list, tuple))
     parts, masters, B, Qs = vc_parts(G, dx, fam, phi, index, x, variant)
     nf = len(masters)
@@ -531,19 +516,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     if structured:
         P = linear_fields(x, active)
         b = b - P @ (P.T @ b)
-    if solver == "auto":
-        solver = "direct" if structured or boundary in ("s", "sn") \
-            else "lsqr"
-        if solver == "direct" and structured and d == 3 \
-                and int(active.sum()) > AMG_VC_LIMIT_3D:
-            solver = "amg"
-    if boundary in ("s", "sn"):
-        if solver != "direct":
-            raise ValueError("the boundary variants 's'/'sn' are solved by "
-                             "sparse LU (solver='direct' or 'auto')")
-    elif solver in ("direct", "amg") and not structured:
-        raise ValueError("the {} VC solve needs V3/V5 without exclude; "
-                         "use solver='lsqr'".format(solver))
+    solver = _vc_solver(solver, structured, boundary, d, int(active.sum()))
     notes = []
     unknowns = d * nf
 
@@ -552,6 +525,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         rows = np.repeat(keep, d)
         return _solve_lsqr(A[rows], b[rows], tol, maxiter or 20 * unknowns)
 
+    R = None
     if boundary in ("s", "sn"):
         R, T = vc_boundary.reduction(
             masters, area if surface is None else surface, boundary, n,
@@ -564,29 +538,83 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         its, unknowns = 2, T.shape[1]
         notes.append("boundary {}: {} equations and unknowns".format(
             boundary, R.shape[0]))
-    elif solver == "lsqr":
-        alpha, its = lsqr()
-    elif solver in ("direct", "amg"):
-        try:
-            alpha, its, used = solve_pinned_lu(
-                matrix(scalar=True), masters, B, b, x, active,
-                min_norm=boundary == "min-norm", iterative=solver == "amg")
-            if used != solver:
-                notes.append("AMG-GMRES did not converge; solved by LU")
-                solver = used
-        except RuntimeError as err:  # singular beyond the linear fields
-            notes.append("direct solve failed ({}); fell back to LSQR"
-                         .format(err))
-            solver = "lsqr"
-            alpha, its = lsqr()
     else:
-        raise ValueError("unknown VC solver {!r}: use 'direct', 'amg', "
-                         "'lsqr' or 'auto'".format(solver))
+        alpha, its, solver = _solve_pinned_or_lsqr(
+            solver, matrix, lsqr, masters, B, b, x, active, boundary, notes)
     Gc = vc_apply(parts, Qs, alpha.reshape(-1, d))
     r1 = residual(Gc)
     if not grouped:
         Gc = Gc[0]
-    if boundary in ("s", "sn"):  # imposed: R r = 0; the rest moves A^i
+    rep = _vc_report(variant, solver, boundary, unknowns, its, notes, r0, r1,
+                     R, keep, area_scale, time.perf_counter() - t0)
+    return Gc, rep
+
+
+def _check_vc_options(variant, boundary, exclude):
+    if variant not in ("V1", "V2", "V3", "V4", "V5"):
+        raise ValueError("VC variant {!r} is not available (V1, V2, V3, "
+                         "V4, V5; second order: skfem_pg.discretization.vc2)"
+                         .format(variant))
+    if boundary not in BOUNDARY_VARIANTS:
+        raise ValueError("VC boundary variant {!r} is not available: use "
+                         "one of {}".format(boundary,
+                                            ", ".join(BOUNDARY_VARIANTS)))
+    if boundary != "min-norm" and exclude is not None:
+        raise ValueError("vc_exclude is for the minimum-norm solve; the "
+                         "boundary variants 'p', 's', 'sn' choose the "
+                         "released constraints themselves")
+    if boundary == "p" and variant not in ("V3", "V5"):
+        raise ValueError("boundary variant 'p' pins the d + d² linear "
+                         "modes of V3/V5; {} has others: use 's' or 'sn'"
+                         .format(variant))
+
+
+def _vc_solver(solver, structured, boundary, d, n_active):
+    """The solver ``"auto"`` stands for, or a named error for one that
+    cannot solve this system (:func:`vc_correction`'s ``solver``)."""
+    if solver == "auto":
+        solver = "direct" if structured or boundary in ("s", "sn") \
+            else "lsqr"
+        if solver == "direct" and structured and d == 3 \
+                and n_active > AMG_VC_LIMIT_3D:
+            solver = "amg"
+    if boundary in ("s", "sn"):
+        if solver != "direct":
+            raise ValueError("the boundary variants 's'/'sn' are solved by "
+                             "sparse LU (solver='direct' or 'auto')")
+    elif solver in ("direct", "amg") and not structured:
+        raise ValueError("the {} VC solve needs V3/V5 without exclude; "
+                         "use solver='lsqr'".format(solver))
+    elif solver not in ("direct", "amg", "lsqr"):
+        raise ValueError("unknown VC solver {!r}: use 'direct', 'amg', "
+                         "'lsqr' or 'auto'".format(solver))
+    return solver
+
+
+def _solve_pinned_or_lsqr(solver, matrix, lsqr, masters, B, b, x, active,
+                          boundary, notes):
+    """``(alpha, iterations, solver used)`` of the min-norm / ``p``
+    system: the pinned scalar LU (or AMG-GMRES), falling back to LSQR
+    where the system is singular beyond the linear fields."""
+    if solver == "lsqr":
+        return lsqr() + (solver,)
+    try:
+        alpha, its, used = solve_pinned_lu(
+            matrix(scalar=True), masters, B, b, x, active,
+            min_norm=boundary == "min-norm", iterative=solver == "amg")
+        if used != solver:
+            notes.append("AMG-GMRES did not converge; solved by LU")
+        return alpha, its, used
+    except RuntimeError as err:  # singular beyond the linear fields
+        notes.append("direct solve failed ({}); fell back to LSQR"
+                     .format(err))
+        return lsqr() + ("lsqr",)
+
+
+def _vc_report(variant, solver, boundary, unknowns, its, notes, r0, r1, R,
+               keep, area_scale, seconds):
+    n, d = r1.shape
+    if R is not None:  # imposed: R r = 0; the rest moves A^i
         imposed = (R @ r0.ravel(), R @ r1.ravel())
         area_correction = r1.T.copy()
         per_particle = (R.T @ imposed[1]).reshape(n, d)
@@ -595,13 +623,13 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         area_correction = None
         per_particle = r1 * keep[:, None]
     rep = VCReport(variant=variant, solver=solver, unknowns=unknowns,
-                   constraints=(R.shape[0] if boundary in ("s", "sn")
+                   constraints=(R.shape[0] if R is not None
                                 else int(keep.sum()) * d),
                    residual_before=float(np.abs(imposed[0]).max()
                                          / area_scale),
                    residual_after=float(np.abs(imposed[1]).max()
                                         / area_scale),
-                   iterations=its, seconds=time.perf_counter() - t0,
+                   iterations=its, seconds=seconds,
                    notes=notes, boundary=boundary,
                    area_correction=area_correction,
                    particle_residuals=np.abs(per_particle).max(axis=1)
@@ -611,7 +639,7 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
             "{}'s full system is incompatible: release the surface "
             "constraints (vc_boundary='s' or 'sn') or pass the Dirichlet "
             "particles as vc_exclude".format(variant))
-    return Gc, rep
+    return rep
 
 
 #: largest accepted |G^{kji}|·h_k of corrected derivatives: beyond it the

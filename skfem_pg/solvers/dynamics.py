@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FamilyError, ParticleError
+from .checkpoint import load as load_checkpoint
 from .static import padded_vector
 
 
@@ -250,6 +251,31 @@ class Progress:
                   e["external_work"] + e["prescribed_work"],
                   e["contact_loss"], e["relative_error"]),
               file=self.stream, flush=True)
+
+
+def resume_run(path, model, energy, hist):
+    """The state a time-stepping checkpoint holds (:func:`save_run`):
+    ``(x, t, v, a, f_int, held, saved)``; the energy accounts and the
+    records are restored into ``energy`` and ``hist``, the model's
+    history by :func:`~skfem_pg.solvers.checkpoint.load`.  ``saved``
+    holds the integrator's own entries (its step controller)."""
+    x, t, saved = load_checkpoint(path, model, state=True)
+    energy.restore(saved)
+    hist[:] = history_of(saved["records"])
+    return (x, t, saved["v"], saved["a"], saved["f_int"],
+            saved["held"].astype(bool), saved)
+
+
+def save_run(every, count, model, x, t, v, a, f_int, held, energy, hist,
+             **controller):
+    """Write a time-stepping run's state (unknowns, velocities,
+    accelerations, internal force, held dofs, energy accounts, records and
+    the integrator's ``controller`` entries) through ``every``
+    (:class:`~skfem_pg.solvers.checkpoint.Every`, atomically) at the
+    ``count``-th step."""
+    every.save(count, model, x, t, v=v, a=a, f_int=f_int,
+               held=held.astype(float), records=history_text(hist),
+               **energy.accounts(), **controller)
 
 
 def stored_energy(model, state):

@@ -44,11 +44,11 @@ from ..dofs import as_dofs
 from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
-from .checkpoint import Every, load as load_checkpoint
+from .checkpoint import Every
 from .controls import ExplicitControls
-from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
-                       Trajectory, MAX_STEPS, bind_walls, check_run, commit,
-                       free_mask, history_of, history_text, stored_energy,
+from .dynamics import (DynamicsError, EnergyBalance, MAX_STEPS, Progress,
+                       Recorder, Trajectory, bind_walls, check_run, commit,
+                       free_mask, resume_run, save_run, stored_energy,
                        time_functions)
 from ..discretization.particles import inverted_cells
 
@@ -237,15 +237,11 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
     if resume is None:
         output()
     else:
-        u, t, saved = load_checkpoint(resume, model, state=True)
-        v, a, fi = saved["v"], saved["a"], saved["f_int"]
-        held = saved["held"].astype(bool)
+        u, t, v, a, fi, held, saved = resume_run(resume, model, energy, hist)
         steps, step, base = int(saved["steps"]), float(saved["step"]), \
             float(saved["base"])
         output_every = int(saved["output_every"])
         F_est = saved.get("F_est")
-        energy.restore(saved)
-        hist[:] = history_of(saved["records"])
         state = _evaluate(model, u, t, hist, v)
         fe = f_of(t)
     every = Every.of(checkpoint)
@@ -272,10 +268,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         vh[Dd] = (un[Dd] - u[Dd]) / h
         t1 = time.perf_counter()
         was_held = held.copy()
-        for w, c in zip(walls, cand):  # behind the wall: onto it
-            pen = w.penetrating(un) | held[c]
-            un[c[pen]] = w.wall_values()[pen]
-            vh[c[pen]] = (un[c[pen]] - u[c[pen]]) / h
+        _onto_walls(walls, cand, held, u, un, vh, h)
         times["contact"] += time.perf_counter() - t1
         t1 = time.perf_counter()
         state = _evaluate(model, un, t + h, hist, v, u)
@@ -289,13 +282,7 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         vn = vh + 0.5 * h * a_n
         vn[Dd] = vh[Dd]
         t1 = time.perf_counter()
-        held[:] = False
-        for w, c in zip(walls, cand):  # hold while pushed into the wall
-            on = w.on_wall(un)
-            into = w.side * (vn[c] + 0.5 * h * a_n[c]) < 0
-            hc = c[on & into]
-            held[hc] = True
-            vn[hc], a_n[hc] = 0.0, 0.0
+        _hold_on_walls(walls, cand, held, un, vn, a_n, h)
         touched = np.flatnonzero(held | was_held)
         times["contact"] += time.perf_counter() - t1
         energy.step(un - u, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
@@ -317,13 +304,33 @@ def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
         else:
             progress(t, h, steps, rec_err)
         if every is not None:
-            every.save(steps, model, u, t, v=v, a=a, f_int=fi,
-                       held=held.astype(float), steps=steps, step=step,
-                       base=base, output_every=output_every,
-                       records=history_text(hist), **energy.accounts(),
-                       **({} if F_est is None else {"F_est": F_est}))
+            save_run(every, steps, model, u, t, v, a, fi, held, energy, hist,
+                     steps=steps, step=step, base=base,
+                     output_every=output_every,
+                     **({} if F_est is None else {"F_est": F_est}))
     times["total"] = time.perf_counter() - t_start
     return Trajectory(u, v, a, t, hist, steps, times)
+
+
+def _onto_walls(walls, cand, held, u, un, vh, h):
+    """Predicted positions behind a wall (or held on it) go onto it, with
+    the half-step velocity that gets them there (in place)."""
+    for w, c in zip(walls, cand):
+        pen = w.penetrating(un) | held[c]
+        un[c[pen]] = w.wall_values()[pen]
+        vh[c[pen]] = (un[c[pen]] - u[c[pen]]) / h
+
+
+def _hold_on_walls(walls, cand, held, un, vn, a_n, h):
+    """``held``: the dofs on a wall that the step would push into it;
+    their velocity and acceleration are zeroed (in place)."""
+    held[:] = False
+    for w, c in zip(walls, cand):
+        on = w.on_wall(un)
+        into = w.side * (vn[c] + 0.5 * h * a_n[c]) < 0
+        hc = c[on & into]
+        held[hc] = True
+        vn[hc], a_n[hc] = 0.0, 0.0
 
 
 def _evaluate(model, u, t, hist, v, u_last=None):

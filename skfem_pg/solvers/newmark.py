@@ -32,11 +32,10 @@ import scipy.sparse as sp
 
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
-from .checkpoint import Every, load as load_checkpoint
+from .checkpoint import Every
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
-                       Trajectory, bind_walls, check_run, commit,
-                       free_mask, history_of, history_text, stored_energy,
-                       time_functions)
+                       Trajectory, bind_walls, check_run, commit, free_mask,
+                       resume_run, save_run, stored_energy, time_functions)
 from .controls import NewmarkControls
 from .static import condensed_solver, newton_step
 
@@ -163,13 +162,9 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     hist = out.hist
     t, steps, step, cuts = 0.0, 0, float(dt), 0
     if resume is not None:
-        x, t, saved = load_checkpoint(resume, model, state=True)
-        v, a, fi = saved["v"], saved["a"], saved["f_int"]
-        held = saved["held"].astype(bool)
+        x, t, v, a, fi, held, saved = resume_run(resume, model, energy, hist)
         step, steps, cuts = float(saved["step"]), int(saved["steps"]), \
             int(saved["cuts"])
-        energy.restore(saved)
-        hist[:] = history_of(saved["records"])
         state = model.state(x)
         fe = f_of(t)
     solvers = {}
@@ -215,10 +210,8 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         if steps % c.output_every == 0 or final:
             output(info, final)
         if every is not None:
-            every.save(steps, model, x, t, v=v, a=a, f_int=fi,
-                       held=held.astype(float), step=step, steps=steps,
-                       cuts=cuts, records=history_text(hist),
-                       **energy.accounts())
+            save_run(every, steps, model, x, t, v, a, fi, held, energy, hist,
+                     step=step, steps=steps, cuts=cuts)
     times["total"] = sum(times.values())
     return Trajectory(x, v, a, t, hist, steps, times)
 
