@@ -34,7 +34,7 @@ import numpy as np
 import skfem_pg as pg
 from skfem_pg.materials import NeoHooke
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.io import VTUSeries
+from skfem_pg.io import VTUSeries
 from harness import (demo_parser, markdown_table, new_figure, output_dir,
                      save_figure, update_results)
 from skfem_pg.solvers import DynamicsError, lumped_mass, newmark

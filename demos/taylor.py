@@ -49,7 +49,7 @@ import skfem_pg as pg
 from skfem_pg.materials import J2Plasticity
 from skfem_pg.naming import knn_name
 from skfem_pg.scenes import Scene
-from skfem_pg.scenes.io import VTUSeries, step_writer
+from skfem_pg.io import VTUSeries, step_writer
 from harness import (demo_parser, markdown_table, new_figure, output_dir,
                      save_figure, update_results)
 from skfem_pg.solvers import (DynamicsError, RigidWall, central_difference,

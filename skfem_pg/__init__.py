@@ -25,7 +25,7 @@ from .errors import (ParticleError, FamilyError, CorrectionError,
 from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
-from .scenes.io import write_vtu
+from .io import write_vtu
 from .registry import register as register_formulation
 
 __version__ = "0.1.0"

@@ -62,7 +62,7 @@ def test_vtu_series_lists_its_steps(tmp_path):
     after each step; the files are the particles with their fields."""
     import re
     import meshio
-    from skfem_pg.scenes.io import VTUSeries
+    from skfem_pg.io import VTUSeries
     mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 3)] * 2)
     p = pg.Particles.from_mesh(mesh)
     series = VTUSeries(str(tmp_path / "run"))

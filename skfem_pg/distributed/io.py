@@ -6,7 +6,7 @@ from xml.sax.saxutils import quoteattr
 import meshio
 import numpy as np
 
-from ..scenes.io import point_arrays
+from ..io import point_arrays
 
 
 def write_pvtu(filename, part, **point_data):

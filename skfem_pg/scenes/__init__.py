@@ -1,7 +1,7 @@
 """Scenes: one problem solved by any formulation name (``scene``), cached
 FE overkill references (``reference``), node sets from the ``.geo``
-sources of the repository's ``meshes/`` (``meshing``), VTU output
-(``io``) and result pages (``reporting``)."""
+sources of the repository's ``meshes/`` (``meshing``).  VTU output is
+:mod:`skfem_pg.io`."""
 from .scene import Scene, Result, inside, centroid_tree
 
 __all__ = ["Scene", "Result", "inside",

@@ -5,7 +5,7 @@ import os
 import numpy as np
 import meshio
 
-from ..discretization.layout import is_family_basis
+from .discretization.layout import is_family_basis
 
 
 def write_vtu(filename, particles, **point_data):
