@@ -26,6 +26,9 @@ from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
 from .io import write_vtu
+from .scenes import Scene
+from .solvers import (newton, newmark, central_difference, lumped_mass,
+                      NewtonControls)
 from .registry import register as register_formulation
 
 __version__ = "0.1.0"
@@ -37,4 +40,6 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "solvers", "analysis", "scenes", "families", "shape",
            "corrections", "meshing", "particles", "loads",
            "ParticleError", "FamilyError", "CorrectionError",
-           "UnsupportedMeshError", "registry", "register_formulation"]
+           "UnsupportedMeshError", "registry", "register_formulation",
+           "Scene", "newton", "newmark", "central_difference",
+           "lumped_mass", "NewtonControls"]

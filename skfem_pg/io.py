@@ -9,7 +9,8 @@ from .discretization.layout import is_family_basis
 
 
 def write_vtu(filename, particles, **point_data):
-    """Write particles and their fields for ParaView.
+    """Write particles (a :class:`~skfem_pg.Particles` or a
+    :class:`~skfem_pg.FamilyBasis`) and their fields for ParaView.
 
     Particles collocated from a mesh's vertices are written with the
     collocation mesh's cells (those of the PG subdomain for an element
@@ -21,6 +22,13 @@ def write_vtu(filename, particles, **point_data):
     ``(n, d, d)`` tensors written as ``(n, 9)`` (3×3, zero-padded), as
     ParaView expects.
     """
+    if is_family_basis(particles):  # a basis: its particles
+        particles = particles.particles
+    if not hasattr(particles, "kind"):
+        raise TypeError("write_vtu takes a skfem_pg.Particles or a "
+                        "FamilyBasis, got {}; for a scikit-fem basis use "
+                        "its mesh's meshio export (mesh.save)".format(
+                            type(particles).__name__))
     n = particles.n
     pts = np.zeros((n, 3))
     pts[:, :particles.dim] = particles.x.T

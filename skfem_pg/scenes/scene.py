@@ -96,6 +96,24 @@ class Scene:
                        for k, v in (probes or {}).items()}
         self.steps = steps
         self.params = params or {}
+        self._check_boundaries()
+
+    def _check_boundaries(self):
+        """Every boundary the scene names exists on the mesh (else a
+        ``ValueError`` with the names the mesh has, now rather than deep in
+        scikit-fem at :meth:`solve`)."""
+        named = list(self.clamped) + [k for k in self.prescribed
+                                      if isinstance(k, str)] + [
+            k for k in self.tractions if isinstance(k, str)]
+        have = sorted((self.mesh.boundaries or {}).keys())
+        missing = sorted(set(named) - set(have))
+        if missing:
+            raise ValueError(
+                "scene {!r} names the boundaries {} that its mesh does not "
+                "have; the mesh has {} (name facets with "
+                "mesh.with_boundaries({{'right': lambda x: x[0] == 1}}))"
+                .format(self.name, ", ".join(map(repr, missing)),
+                        ", ".join(map(repr, have)) if have else "none"))
 
     @property
     def dim(self):

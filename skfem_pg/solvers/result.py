@@ -35,6 +35,21 @@ class Result:
     def total_time(self):
         return sum(self.times.values())
 
+    def __repr__(self):
+        """One line: method, unknowns, load steps, probes, seconds (the
+        dataclass' default printed every array in full)."""
+        probes = ", ".join("{}=({})".format(k, ", ".join(
+            "{:.5g}".format(c) for c in np.ravel(v)))
+            for k, v in self.probes.items())
+        return "<{} {!r}: {} displacement dofs{}, {} load step(s){}, " \
+            "{:.2f} s>".format(
+                type(self).__name__, self.method, len(self.u),
+                "" if not self.fields else " + " + ", ".join(self.fields),
+                len(self.history), "" if not probes else ", " + probes,
+                self.total_time)
+
+    __str__ = __repr__
+
     def residual(self):
         """:math:`f_{int}(u) - f_{ext}` on the displacement dofs: zero
         (to the solver's tolerance) where the displacements are free, the
