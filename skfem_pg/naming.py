@@ -38,7 +38,8 @@ So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
 its own, measured defaults: the bond correction as there (on for MTE1) and
 the minimum-norm VC solve (``vc_boundary="min-norm"``), which passes the
 same patch tests and is less erratic than ``sn`` on 3-D tetrahedra
-(README); ``FamilyBasis.from_name(p, name, vc_boundary="min-norm")`` or
+(``benchmarks/README.md``); ``FamilyBasis.from_name(p, name,
+vc_boundary="min-norm")`` or
 the suffix ``m`` gets it for a thesis name.
 
 Every formulation of Table 7.1 parses: :func:`parse` gives the options of

@@ -2,28 +2,29 @@
 (Table 7.1's ``Unl``, ``UnlP0``, ... and any a user adds) with what the
 package derives from it.
 
-================  =====================================================
-field             used by
-================  =====================================================
-``shape``         :func:`skfem_pg.naming.parse`: the shape functions of
-                  the displacement basis (``WTE1``, ``MTE1``, ``WTE2``);
-                  first order (WTE1, MTE1): the bond correction is the
-                  default
-``build``         :func:`skfem_pg.formulations.model_for`:
-                  ``build(basis, material, tangent)`` returns the model
-                  (:class:`~skfem_pg.formulations.Hyperelastic` or a
-                  subclass: ``state``, ``internal_force``, ``tangent``,
-                  ``commit``, ``min_J``, ``n_u``; what Newton's method,
-                  Newmark and central differences ask of it)
-``kind``          ``"displacement"`` (a basis of this shape is named by
-                  it: :func:`skfem_pg.naming.name_of`), ``"mixed"``
-                  or ``"stabilized"``
-``master_only``   the gradient lives at the master alone: no bond
-                  correction (U1SIG)
-``updated_lagrangian``  the UL frame is built for it
-``distributed``   the distributed Newton solves it
-                  (``Scene.solve(..., comm=...)``)
-================  =====================================================
+========================  =====================================================
+field                     used by
+========================  =====================================================
+``shape``                 :func:`skfem_pg.naming.parse`: the shape functions of
+                          the displacement basis (``WTE1``, ``MTE1``,
+                          ``WTE2``);
+                          first order (WTE1, MTE1): the bond correction is the
+                          default
+``build``                 :func:`skfem_pg.formulations.model_for`:
+                          ``build(basis, material, tangent)`` returns the model
+                          (:class:`~skfem_pg.formulations.Hyperelastic` or a
+                          subclass: ``state``, ``internal_force``, ``tangent``,
+                          ``commit``, ``min_J``, ``n_u``; what Newton's method,
+                          Newmark and central differences ask of it)
+``kind``                  ``"displacement"`` (a basis of this shape is named by
+                          it: :func:`skfem_pg.naming.name_of`), ``"mixed"``
+                          or ``"stabilized"``
+``master_only``           the gradient lives at the master alone: no bond
+                          correction (U1SIG)
+``updated_lagrangian``    the UL frame is built for it
+``distributed``           the distributed Newton solves it
+                          (``Scene.solve(..., comm=...)``)
+========================  =====================================================
 
 :mod:`skfem_pg.formulations.by_name` registers Table 7.1; a formulation
 of one's own is one :func:`register` call, after which names with its

@@ -1,4 +1,6 @@
-r"""Poisson's equation: scikit-fem's first example on particles.
+r"""
+Poisson's equation: scikit-fem's first example on particles
+===========================================================
 
 Solve :math:`-\Delta u = 1` in the unit square with :math:`u = 0` on its
 boundary (scikit-fem's ``docs/examples/ex01.py``) twice on the same

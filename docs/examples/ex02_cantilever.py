@@ -1,5 +1,6 @@
-r"""Linear elasticity: particles and FE on the same nodes, against an
-overkill.
+r"""
+Linear elasticity: particles and FE on the same nodes, against an overkill
+==========================================================================
 
 A plane-strain cantilever, 48 × 12, clamped on the left and sheared on the
 right (:math:`\lambda = 100`, :math:`\mu = 40`), on distorted

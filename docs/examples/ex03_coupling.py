@@ -1,4 +1,6 @@
-r"""FE and particles in one model, coupled through shared nodes.
+r"""
+FE and particles in one model, coupled through shared nodes
+===========================================================
 
 A family basis collocated from some cells of a mesh numbers its unknowns
 like scikit-fem's vector elements on the whole mesh, so an FE basis on the

@@ -1,4 +1,6 @@
-r"""Near incompressibility: formulations by name on one scene.
+r"""
+Near incompressibility: formulations by name on one scene
+=========================================================
 
 Cook's membrane (48 × 44/16 × 60, clamped on the left, a shear traction of
 total force 1 on the right) of a nearly incompressible neo-Hooke material

@@ -1,4 +1,6 @@
-r"""Dynamics: a cantilever set vibrating, by Newmark's method.
+r"""
+Dynamics: a cantilever set vibrating, by Newmark's method
+=========================================================
 
 The plane-strain cantilever of ex02 (48 × 12, neo-Hooke,
 :math:`\lambda = 100`, :math:`\mu = 40`, :math:`\rho_0 = 0.1`) starts from

@@ -3,26 +3,26 @@ derivatives → corrections → :class:`FamilyBasis`, and the batched assembly
 that turns scikit-fem forms on it (and on FE cell bases) into sparse
 systems.
 
-=====================  ====================================================
-``particles``          particles collocated from meshes (volumes, area
-                       vectors, fold and inversion checks)
-``families``           family builders (mesh connectivity, horizons,
-                       nearest neighbours) and their rule names
-``recipes``            which families, quadrature and bond weights a
-                       basis uses by default (thesis' or kNN)
-``quadrature``         PBG quadrature weights (volume (4.30), uniform)
-``shape``              WTE1/MTE1, WTE2, least-squares and LME derivatives
-``corrections``        bond (5.55) and VC (5.57)–(5.64) corrections;
-                       ``vc_boundary``, ``vc2``: boundary variants, VC2
-``petrov``             PPG test bases (4.21), (4.22)
-``layout``             families grouped by size (unpadded hot paths)
-``builder``            :class:`BasisSpec` (every option, resolved) and the
-                       stages one builder composes into a basis
-``basis``              :class:`FamilyBasis`, the container of the built
-                       arrays behind scikit-fem's basis interface
-``assembly``, ``forms``  batched assembly; the fast-path decorators
-``loads``              tractions, stress and body loads on FE and PG bases
-=====================  ====================================================
+=========================  ====================================================
+``particles``              particles collocated from meshes (volumes, area
+                           vectors, fold and inversion checks)
+``families``               family builders (mesh connectivity, horizons,
+                           nearest neighbours) and their rule names
+``recipes``                which families, quadrature and bond weights a
+                           basis uses by default (thesis' or kNN)
+``quadrature``             PBG quadrature weights (volume (4.30), uniform)
+``shape``                  WTE1/MTE1, WTE2, least-squares and LME derivatives
+``corrections``            bond (5.55) and VC (5.57)–(5.64) corrections;
+                           ``vc_boundary``, ``vc2``: boundary variants, VC2
+``petrov``                 PPG test bases (4.21), (4.22)
+``layout``                 families grouped by size (unpadded hot paths)
+``builder``                :class:`BasisSpec` (every option, resolved) and the
+                           stages one builder composes into a basis
+``basis``                  :class:`FamilyBasis`, the container of the built
+                           arrays behind scikit-fem's basis interface
+``assembly``, ``forms``    batched assembly; the fast-path decorators
+``loads``                  tractions, stress and body loads on FE and PG bases
+=========================  ====================================================
 """
 from .particles import Particles
 from .families import Families

@@ -642,9 +642,9 @@ def _vc_report(variant, solver, boundary, unknowns, its, notes, r0, r1, R,
     return rep
 
 
-#: largest accepted |G^{kji}|·h_k of corrected derivatives: beyond it the
+#: largest accepted ``|G^{kji}|·h_k`` of corrected derivatives: beyond it the
 #: correction cancels more than six digits (the largest seen in a correct
-#: basis: 2.2e3, boundary variant p on the 3-D Cook tets; |ΔG|·h of the
+#: basis: 2.2e3, boundary variant p on the 3-D Cook tets; ``|ΔG|·h`` of the
 #: WTE2 s-variant at 9×9 particles, which loses the patch test to 1e-6:
 #: 1e5)
 GRADIENT_LIMIT = 1e6

@@ -13,16 +13,16 @@ A recipe is three choices made together, because they act together:
   in the Taylor expansions (thesis (3.33); :math:`n = 0` weighs every
   bond the same).
 
-=========  ==========================================  ===================
-recipe     families, weights, exponent                 default for
-=========  ==========================================  ===================
-``mesh``   ``"mesh"``, ``"volume"``, 1 (the thesis')   2-D; hexahedra;
-                                                       PPG, WTE1/WTE2;
-                                                       particles w/o mesh
-                                                       (``"horizon"``)
-``kNN``    ``"nearest"`` (10, pairwise), ``"uniform"``, PBG MTE1 on 3-D
-           0                                           tetrahedra
-=========  ==========================================  ===================
+=========  ===============================================  ===================
+recipe     families, weights, exponent                      default for
+=========  ===============================================  ===================
+``mesh``   ``"mesh"``, ``"volume"``, 1 (the thesis')        2-D; hexahedra;
+                                                            PPG, WTE1/WTE2;
+                                                            particles w/o mesh
+                                                            (``"horizon"``)
+``kNN``    ``"nearest"`` (10, pairwise), ``"uniform"``, 0   PBG MTE1 on 3-D
+                                                            tetrahedra
+=========  ===============================================  ===================
 
 Why ``kNN`` on tetrahedra.  A gmsh tetrahedral mesh gives a vertex 14
 neighbours on average and as many as 30, spread over the cells around it;

@@ -32,7 +32,7 @@ one sparse LU.  Neumann loads must then use the discrete surface vectors
 constraint with the FE-consistent :math:`A^i` and takes the minimum-norm
 solution instead.
 
-Measured (README): all variants pass the linear patch test, none is more
+Measured (``benchmarks/README.md``): all variants pass the linear patch test, none is more
 accurate than min-norm on the 2-D manufactured problem (L2 / Q1: 2.46
 min-norm, 2.39 p, 2.72 sn), and on the 3-D Cook tetrahedra ``p`` and
 ``sn`` are erratic (corner errors −60 % and −35 % on one node set each).

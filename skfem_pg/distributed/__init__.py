@@ -17,7 +17,7 @@ particles it owns; PETSc sums the ranks' parts and solves.
 =================  =====================================================
 
 Run a script on two ranks with ``mpirun -n 2 python script.py``; see
-``demos/cook_mpi.py`` and the README's "MPI" section.
+``demos/cook_mpi.py`` and the user guide's "MPI (PETSc)" page.
 """
 from .comm import as_mpi
 from .partition import Partition, metis_parts

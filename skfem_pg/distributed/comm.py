@@ -3,7 +3,7 @@ first use with an error that names the extra which installs them."""
 
 EXTRA = ("install the MPI extra: pip install 'skfem-pg[mpi]' (compiles "
          "PETSc), or on Debian/Ubuntu apt-get install python3-petsc4py "
-         "python3-mpi4py and pip install pymetis (README, 'MPI')")
+         "python3-mpi4py and pip install pymetis (docs/guide/mpi.md)")
 
 
 def mpi():

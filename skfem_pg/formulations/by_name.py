@@ -1,29 +1,29 @@
 """Formulations by their thesis name (Table 7.1): the model a name's
 formulation token makes of a basis and a material.
 
-======================  ===================================================
-token                   model
-======================  ===================================================
-``Unl``, ``U1``, ``U2``  :class:`~.displacement.Hyperelastic` (PG)
-``T1`` ... ``H2``       :class:`~.displacement.Hyperelastic` (FE)
-``UnlP0``               :class:`~.dilatation.MeanDilatation` (PBG),
-                        :class:`~.master_dilatation.MasterDilatation` (PPG)
-``U2P1``                :class:`~.dilatation.MeanDilatation` of order 1
-                        (PBG, WTE2 basis)
-``Q1P0``, ``H1P0``      :class:`~.dilatation.MeanDilatation`, or with an
-                        incompressible material
-                        :class:`~.incompressible.IncompressibleP0`
-``IUnlP0``              :class:`~.incompressible.IncompressibleP0` (PBG),
-                        :class:`~.master_dilatation.MasterIncompressible`
-                        (PPG)
-``U2P1C``               :class:`~.nodal.NodalPressure` (PBG, WTE2 basis)
-``Unl+P1C``             :class:`~.nodal.NodalPressure` with the bubble
-                        (PBG, MTE1 basis)
-``U1SUnl``              :class:`~.stabilized.U1SUnl` (PBG, MTE1 basis for
-                        the stabilization, WTE1 at the masters)
-``U1SIG``               :class:`~.stabilized.U1SIG` (PBG, WTE1 at the
-                        masters)
-======================  ===================================================
+=========================  ===================================================
+token                      model
+=========================  ===================================================
+``Unl``, ``U1``, ``U2``    :class:`~.displacement.Hyperelastic` (PG)
+``T1`` ... ``H2``          :class:`~.displacement.Hyperelastic` (FE)
+``UnlP0``                  :class:`~.dilatation.MeanDilatation` (PBG),
+                           :class:`~.master_dilatation.MasterDilatation` (PPG)
+``U2P1``                   :class:`~.dilatation.MeanDilatation` of order 1
+                           (PBG, WTE2 basis)
+``Q1P0``, ``H1P0``         :class:`~.dilatation.MeanDilatation`, or with an
+                           incompressible material
+                           :class:`~.incompressible.IncompressibleP0`
+``IUnlP0``                 :class:`~.incompressible.IncompressibleP0` (PBG),
+                           :class:`~.master_dilatation.MasterIncompressible`
+                           (PPG)
+``U2P1C``                  :class:`~.nodal.NodalPressure` (PBG, WTE2 basis)
+``Unl+P1C``                :class:`~.nodal.NodalPressure` with the bubble
+                           (PBG, MTE1 basis)
+``U1SUnl``                 :class:`~.stabilized.U1SUnl` (PBG, MTE1 basis for
+                           the stabilization, WTE1 at the masters)
+``U1SIG``                  :class:`~.stabilized.U1SIG` (PBG, WTE1 at the
+                           masters)
+=========================  ===================================================
 """
 import numpy as np
 

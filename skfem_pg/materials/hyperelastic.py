@@ -213,7 +213,7 @@ class NeoHookeIsoVol(Material):
 
     @classmethod
     def incompressible(cls, mu):
-        """The incompressible limit (:math:`\nu = 0.5`, ``K = inf``): only
+        r"""The incompressible limit (:math:`\nu = 0.5`, ``K = inf``): only
         the formulations with a pressure unknown (IUnlP0,
         :class:`~skfem_pg.formulations.IncompressibleP0`) accept it."""
         m = cls(mu, 1.0)

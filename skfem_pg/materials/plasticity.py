@@ -81,9 +81,15 @@ class ReturnMapError(RuntimeError):
 
 class J2Plasticity(Material):
     r"""Finite J2 elasto-plasticity with neo-Hooke elasticity, von Mises
-    yield and linear plus saturation hardening (module docstring).
+    yield and linear plus saturation hardening (module docstring); the
+    parameters carry the thesis' symbols, (2.46)–(2.49).
 
-    Parameters (the thesis' symbols, (2.46)–(2.49))
+    A stateful material: :meth:`initial_history` gives the history at a
+    set of points and :meth:`update` the response to ``F`` from a
+    committed history.  The formulations bind it to their integration
+    points (:class:`~skfem_pg.formulations.history.History`).
+
+    Parameters
     ----------
     mu, K
         Shear and bulk modulus of the elastic part (``K = np.inf``:
@@ -96,11 +102,6 @@ class J2Plasticity(Material):
         Saturation yield stress (default ``sigma_y0``: no saturation).
     delta
         Saturation exponent.
-
-    A stateful material: :meth:`initial_history` gives the history at a
-    set of points and :meth:`update` the response to ``F`` from a
-    committed history.  The formulations bind it to their integration
-    points (:class:`~skfem_pg.formulations.history.History`).
     """
 
     stateful = True

@@ -79,7 +79,7 @@ def pardiso_available():
 
 #: largest relative residual ``|A x - b| / |b|`` a solve may return: a
 #: singular system (too few Dirichlet conditions) comes back from PARDISO
-#: with a residual of order 1 and |x| ~ 1e13; a well-posed system with a
+#: with a residual of order 1 and ``|x|`` ~ 1e13; a well-posed system with a
 #: condition number up to about 1e10 stays below it
 RESIDUAL_CHECK = 1e-6
 #: above :data:`RESIDUAL_CHECK`, an ill-conditioned but regular system (a

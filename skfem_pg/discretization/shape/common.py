@@ -59,7 +59,7 @@ def chunks(nf, per_family, budget=2 ** 22):
 #: ``sqrt(BOND_FLOOR)`` = 0.032 family radii weighs as one of that length.
 #: Near-coincident particles (two particles 1e-3 mesh spacings apart in a
 #: jittered triangulation) otherwise get :math:`\omega` ~1e6 times their
-#: neighbours', gradient coefficients ~1/|ΔX| and a stiffness matrix whose
+#: neighbours', gradient coefficients ``~1/|ΔX|`` and a stiffness matrix whose
 #: round-off alone breaks the linear patch test (max nodal error 1.5e-10
 #: V5m, 3.2e-10 V5p; with the floor ≤ 5.6e-11 on every variant,
 #: tests/test_adversarial.py).  Any positive weights reproduce linear
