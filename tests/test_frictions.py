@@ -63,3 +63,59 @@ def test_traction_on_a_scikit_fem_basis(square):
     assert np.allclose(fe, pgf) and np.isclose(fe[1::2].sum(), 2.0)
     scalar = pg.traction(fem.Basis(square, fem.ElementQuad1()), right, 3.0)
     assert np.isclose(scalar.sum(), 3.0)
+
+
+def test_with_element_says_what_to_do(square):
+    b = pg.FamilyBasis(square, dim=2)
+    with pytest.raises(NotImplementedError, match="particle_fields"):
+        b.with_element(fem.ElementDG(fem.ElementQuad1()))
+
+
+def test_fe_quadrature_data_in_a_pg_form_is_named(square):
+    """Data at an FE basis' quadrature points, or a dof vector of another
+    element, handed to a PG form: a message naming the coefficient and
+    what to pass instead (was scikit-fem's "Quadrature mismatch" or
+    "Input array has wrong size")."""
+    from skfem.helpers import dot, grad
+
+    @pg.BilinearForm
+    def weighted(u, v, w):
+        return w.k * dot(grad(u), grad(v))
+
+    b = pg.FamilyBasis(square)
+    fe = fem.Basis(square, fem.ElementQuad1())
+    k_fe = fe.interpolate(np.ones(fe.N))  # at FE quadrature points
+    with pytest.raises(ValueError, match="'k'.*family members.*w.x"):
+        weighted.assemble(b, k=k_fe)
+    q2 = fem.Basis(square, fem.ElementQuad2())
+    with pytest.raises(ValueError, match="'k' has 81 entries.*probes"):
+        weighted.assemble(b, k=np.ones(q2.N))
+    # what works: a dof vector of this basis, or its interpolation
+    K1 = weighted.assemble(b, k=np.ones(b.N))
+    K2 = weighted.assemble(b, k=b.interpolate(np.ones(b.N)))
+    assert abs(K1 - K2).max() < 1e-12
+
+
+def test_a_scalar_coefficient_is_evaluated_at_every_family():
+    """A scalar dof vector as form coefficient is the particle values at
+    each family's members: the same matrix as the coefficient written as
+    a function of ``w.x``.  (The scalar ``interpolate`` returned the first
+    family's values for every family, shape ``(m,)`` instead of ``(nf,
+    m)``, which broadcast silently.)"""
+    from skfem.helpers import dot, grad
+    mesh = pg.meshing.distort(fem.MeshQuad.init_tensor(
+        *(np.linspace(0, 1, 7),) * 2), 0.2, seed=1)
+    b = pg.FamilyBasis(mesh)
+
+    @pg.BilinearForm
+    def by_values(u, v, w):
+        return w.k * dot(grad(u), grad(v))
+
+    @pg.BilinearForm
+    def by_position(u, v, w):
+        return (1.0 + w.x[0] * w.x[1]) * dot(grad(u), grad(v))
+
+    k = 1.0 + b.particles.x[0] * b.particles.x[1]
+    assert np.asarray(b.interpolate(k)).shape == b.dx.shape
+    A, B = by_values.assemble(b, k=k), by_position.assemble(b)
+    assert abs(A - B).max() <= 1e-12 * abs(B).max()

@@ -220,8 +220,40 @@ def _used_channels(C, nc, nch):
     return [int(b) for b in used] or [1]
 
 
+def check_coefficients(basis, kwargs):
+    """Named errors for form coefficients a family basis cannot use:
+    arrays at another basis' quadrature points (an FE basis' ``(cells,
+    points)``: PG integrates at the family members, ``(nf, m)``) and dof
+    vectors of another length (a field of another element)."""
+    nf, m = basis.families.padded()[0].shape
+    for k, v in kwargs.items():
+        if isinstance(v, DiscreteField) or (isinstance(v, np.ndarray)
+                                            and v.ndim > 1):
+            shape = np.asarray(v).shape
+            if shape[-2:] not in ((nf, m), (1, basis.layout.n_points)):
+                raise ValueError(
+                    "form coefficient {!r} has its values at {} points "
+                    "(shape {}); a FamilyBasis integrates at its family "
+                    "members, ({}, {}) points.  Data from an FE basis' "
+                    "quadrature cannot be used here: pass a callable of "
+                    "the position and evaluate it in the form at w.x, a "
+                    "dof vector of this basis (length {}), or "
+                    "basis.interpolate(u) of this basis".format(
+                        k, shape[-2:], shape, nf, m, basis.N))
+        elif isinstance(v, np.ndarray) and v.ndim == 1 \
+                and v.shape[0] != basis.N:
+            raise ValueError(
+                "form coefficient {!r} has {} entries, this FamilyBasis {} "
+                "dofs: a field of another basis (another element) must "
+                "first be sampled at the particles, e.g. "
+                "fe_basis.probes(basis.particles.x) @ u_fe per component"
+                .format(k, v.shape[0], basis.N))
+
+
 def _setup(form, basis, view, kwargs):
     """``w`` and probes shared by the bilinear and linear paths."""
+    if isinstance(basis, FamilyBasis):
+        check_coefficients(basis, kwargs)
     w = FormExtraParams({**basis.default_parameters(),
                          **form._normalize_asm_kwargs(kwargs, basis)})
     return w, _probes(view)

@@ -434,7 +434,10 @@ class FamilyBasis(AbstractBasis):
         if flat:
             value, grad = value[..., None, :], grad[..., None, :]
         else:
-            value, grad = L.flat_to_padded(value), L.flat_to_padded(grad)
+            # (..., 1, N_q) is unambiguous: a leading axis of length 1 (one
+            # component, 1-D) is not taken for the flat layout's
+            value = L.flat_to_padded(value[..., None, :])
+            grad = L.flat_to_padded(grad[..., None, :])
         if self.ncomp is None:
             value, grad = value[0], grad[0]
         return DiscreteField(value, grad)
@@ -507,6 +510,21 @@ class FamilyBasis(AbstractBasis):
         e1, _ = linear_elements(self.mesh)
         from skfem.visuals.matplotlib import plot
         return plot(fem.Basis(self.mesh, e1), z, **kwargs)
+
+    def with_element(self, elem):
+        """Not available: a family basis has no other element to swap in
+        (its members are its quadrature points).  Raises with what to do
+        instead (scikit-fem's examples use ``with_element`` to project
+        stresses onto a DG element for plotting)."""
+        raise NotImplementedError(
+            "FamilyBasis.with_element({}): a family basis has no other "
+            "element.  For stresses or strains per particle use "
+            "skfem_pg.analysis.postprocess.particle_fields(basis, material, "
+            "u); for "
+            "a field on an FE element of the collocation mesh build "
+            "fem.Basis(basis.mesh, elem) and interpolate the particle "
+            "values there (basis.probes(x) gives the P1/Q1 interpolant)"
+            .format(type(elem).__name__))
 
     def draw(self, **kwargs):
         """The collocation mesh (scikit-fem's ``mesh.draw``)."""
