@@ -1,0 +1,163 @@
+"""scikit-fem's gallery problems with the basis swapped (issue 30).
+
+Each test poses a problem of scikit-fem's ``docs/examples`` (same kind of
+geometry, boundary conditions and load; written here), solves it with a
+scikit-fem element and with a :class:`~skfem_pg.FamilyBasis` on the same
+nodes the way a user would (the library's own forms from
+``skfem.models``, ``pg.assemble``), and compares both with an exact
+solution or a quadratic-element overkill.  The numbers in the docstrings
+are the measured ones; where PG does not come within FE's discretization
+error the test says so with ``xfail(strict=True)``, so that a fix shows.
+"""
+import warnings
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+import skfem as fem
+from scipy.sparse.linalg import eigsh
+from skfem.helpers import dot
+from skfem.models.elasticity import linear_elasticity
+from skfem.models.poisson import laplace, unit_load
+
+import skfem_pg as pg
+
+
+def cube_poisson(x, terms=31):
+    """The triple sine series of -Δu = 1 in the unit cube, u = 0 on its
+    boundary."""
+    k = np.arange(1, 2 * terms, 2)
+    a, b, c = np.meshgrid(k, k, k, indexing="ij")
+    coef = 64 / np.pi ** 5 / (a * b * c * (a ** 2 + b ** 2 + c ** 2))
+    s = [np.sin(np.pi * np.outer(k, xi)) for xi in x]
+    return np.einsum("abc,ai,bi,ci->i", coef, *s)
+
+
+def poisson(basis):
+    K, f = pg.assemble(laplace, basis), pg.assemble(unit_load, basis)
+    return fem.solve(*fem.condense(K, f, D=basis.get_dofs()))
+
+
+def test_library_forms_take_the_fast_path_with_pg_assemble():
+    """``skfem.models`` forms carry scikit-fem's decorator, so
+    ``laplace.assemble(basis)`` takes the generic path on a FamilyBasis
+    (a SlowAssemblyWarning says so); ``pg.assemble(laplace, basis)`` is
+    the one call that takes the fast path, with the same matrix."""
+    mesh = fem.MeshTri.init_sqsymmetric().refined(2)
+    basis = pg.FamilyBasis(mesh)
+    with pytest.warns(pg.SlowAssemblyWarning, match="pg.assemble|"
+                      "skfem_pg.assemble"):
+        generic = laplace.assemble(basis)
+    fast = pg.assemble(laplace, basis)
+    assert abs(generic - fast).max() <= 1e-12 * abs(fast).max()
+
+
+def cube(n, cells):
+    mesh = fem.MeshHex.init_tensor(*(np.linspace(0, 1, n + 1),) * 3)
+    return mesh if cells == "hex" else mesh.to_meshtet()
+
+
+def cube_errors(cells, n):
+    """``(PG, FE)`` errors of the centre value and the largest nodal
+    errors, relative to the exact centre value."""
+    mesh = cube(n, cells)
+    centre = pg.meshing.vertex_at(mesh, (0.5, 0.5, 0.5))
+    exact = cube_poisson(mesh.p)
+    fe = fem.Basis(mesh, fem.ElementHex1() if cells == "hex"
+                   else fem.ElementTetP1())
+    out = []
+    for basis in (pg.FamilyBasis(mesh), fe):
+        u = poisson(basis)
+        out.append((u[centre] / exact[centre] - 1,
+                    np.abs(u - exact).max() / exact[centre]))
+    return out
+
+
+def test_poisson_in_the_unit_cube_on_hexahedra():
+    """ex09's problem, -Δu = 1 in the unit cube: the centre value against
+    the series solution, on 7³ and 11³ nodes.  Measured: PG (thesis
+    recipe) +10.6 / +5.7 %, H1 +4.5 / +1.6 %: PG converges, more slowly
+    and from above (its 1-ring families average the curvature, the
+    softness ex02 shows in bending)."""
+    (pg6, _), (fe6, _) = cube_errors("hex", 6)
+    (pg10, _), (fe10, _) = cube_errors("hex", 10)
+    assert 0 < pg10 < 0.07 and pg6 / pg10 > 1.5
+    assert 0 < fe10 < 0.02
+
+
+def test_poisson_in_the_unit_cube_on_tetrahedra():
+    """The same on the cubes split into tetrahedra (the kNN recipe):
+    centre −0.17 % (O1 −1.49 %) on 11³ nodes, but the largest nodal error
+    6.8 % (O1 1.5 %), next to the Dirichlet boundary, where the ten
+    nearest particles of a family lie on one side (the README's "avoid
+    kNN for smooth fields with full Dirichlet data")."""
+    (pg_c, pg_max), (fe_c, fe_max) = cube_errors("tet", 10)
+    assert abs(pg_c) <= abs(fe_c) < 0.02
+    assert fe_max < 0.02 and pg_max < 0.08
+
+
+def beam(n):
+    mesh = fem.MeshHex.init_tensor(np.linspace(0, 5, 5 * n + 1),
+                                   *(np.linspace(0, 1, n + 1),) * 2)
+    return mesh.with_boundaries({"left": lambda x: x[0] == 0,
+                                 "right": lambda x: x[0] == 5})
+
+
+STIFFNESS = linear_elasticity(1.0, 1.0)
+TIP = np.array([[5.0], [0.5], [0.5]])
+#: H2 on 20 x 4 x 4 cells (its change from 15 x 3 x 3: 6e-4)
+TIP_H2, OMEGA_H2 = -0.20384497, 0.062729572
+
+
+def bend_and_vibrate(basis, mass):
+    K = pg.assemble(STIFFNESS, basis)
+    D = basis.get_dofs("left")
+    f = pg.traction(basis, "right", [0.0, 0.0, -1e-3])
+    u = fem.solve(*fem.condense(K, f, D=D))
+    free = basis.complement_dofs(D)
+    M = mass(basis).tocsr()[free][:, free]
+    omega2 = eigsh(K.tocsr()[free][:, free], 1, M, sigma=0.0)[0][0]
+    return (basis.probes(TIP) @ u)[2] / TIP_H2 - 1, \
+        np.sqrt(omega2) / OMEGA_H2 - 1
+
+
+@fem.BilinearForm
+def consistent_mass(u, v, w):
+    return dot(u, v)
+
+
+def fe_mass(basis):
+    return consistent_mass.assemble(basis)
+
+
+def pg_mass(basis):
+    return sp.diags(pg.lumped_mass(basis, 1.0))
+
+
+def test_elastic_beam_bends_and_vibrates_with_the_knn_recipe():
+    """ex11 / ex21's kind of problem, a 5 x 1 x 1 elastic beam clamped at
+    one end: tip deflection under an end shear and the first
+    eigenfrequency, on 5n x n x n hexahedra (n = 4, 525 nodes).  Measured:
+    H1 −3.4 % / +1.8 %; PG with ten nearest particles per family (the
+    ``kNN`` recipe) −2.0 % and within 2 % of the frequency."""
+    mesh = beam(4)
+    fe = bend_and_vibrate(fem.Basis(mesh, fem.ElementVector(
+        fem.ElementHex1())), fe_mass)
+    knn = bend_and_vibrate(pg.FamilyBasis(mesh, dim=3, families="nearest"),
+                           pg_mass)
+    assert abs(fe[0]) < 0.04 and abs(fe[1]) < 0.02
+    assert abs(knn[0]) <= abs(fe[0]) and abs(knn[1]) < 0.05
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "the default (thesis) recipe on hexahedra is soft in bending: tip "
+    "+38 % and first frequency −15 % at 525 nodes (+18 % tip at 1519), "
+    "against H1's −3.4 % / +1.8 %; the kNN recipe is not the hex default "
+    "(a change of default needs the studies of issue 27)"))
+def test_elastic_beam_with_the_default_recipe_is_within_fe_error():
+    mesh = beam(4)
+    fe = bend_and_vibrate(fem.Basis(mesh, fem.ElementVector(
+        fem.ElementHex1())), fe_mass)
+    default = bend_and_vibrate(pg.FamilyBasis(mesh, dim=3), pg_mass)
+    assert abs(default[0]) <= 2 * abs(fe[0])
+    assert abs(default[1]) <= 2 * abs(fe[1])
