@@ -154,7 +154,8 @@ def main(sizes=(8, 16, 32, 64), distortion=0.3):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32, 64],
+                    help='elements per side of the distorted unit squares')
     ap.add_argument("--distortion", type=float, default=0.3,
                     help="node perturbation in units of h (0: regular)")
     a = ap.parse_args()

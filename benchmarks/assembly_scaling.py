@@ -201,7 +201,8 @@ if __name__ == "__main__":
     ap.add_argument("--sizes", type=int, nargs="+", default=None,
                     help="elements per side (default 100 ... 500 in 2-D, "
                     "20 30 40 in 3-D)")
-    ap.add_argument("--dim", type=int, default=2, choices=(2, 3))
+    ap.add_argument("--dim", type=int, default=2, choices=(2, 3),
+                    help='2: quadrilaterals against Q1; 3: hexahedra against H1')
     ap.add_argument("--amg", action="store_true",
                     help="also time CG + smoothed aggregation solves")
     a = ap.parse_args()

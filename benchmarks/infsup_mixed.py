@@ -142,8 +142,10 @@ def main(sizes=(4, 8, 16), bc="clamped", out=None):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 8, 16])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 8, 16],
+                    help='elements per side of the square node sets')
     ap.add_argument("--bc", choices=["clamped", "thesis"],
-                    default="clamped")
+                    default="clamped",
+                    help="boundary conditions: the clamped square, or the thesis' setting")
     args = ap.parse_args()
     main(args.sizes, args.bc, args.out)

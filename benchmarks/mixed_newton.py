@@ -144,8 +144,11 @@ def main(n2=40, n3=10, repeat=3):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--n2", type=int, default=40)
-    ap.add_argument("--n3", type=int, default=10)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--n2", type=int, default=40,
+                    help='elements per side of the distorted unit square (2-D)')
+    ap.add_argument("--n3", type=int, default=10,
+                    help='elements per side of the distorted unit cube (3-D)')
+    ap.add_argument("--repeat", type=int, default=3,
+                    help='runs per phase; the fastest counts')
     args = ap.parse_args()
     main(args.n2, args.n3, args.repeat)

@@ -75,10 +75,14 @@ def row(kind, r, base=None):
 
 def main():
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--strong", nargs="+", default=["16x4", "24x6"])
-    ap.add_argument("--weak", nargs="+", default=["18x4:24x5"])
-    ap.add_argument("--load", type=float, default=0.5)
-    ap.add_argument("--steps", type=int, default=1)
+    ap.add_argument("--strong", nargs="+", default=["16x4", "24x6"],
+                    help="strong-scaling grids NxNZ (cook_mpi's --n x --nz), each on 1 and 2 ranks")
+    ap.add_argument("--weak", nargs="+", default=["18x4:24x5"],
+                    help='weak-scaling pairs A:B, grid A on 1 rank and grid B (about twice the particles) on 2')
+    ap.add_argument("--load", type=float, default=0.5,
+                    help="fraction of cook_mpi's load")
+    ap.add_argument("--steps", type=int, default=1,
+                    help='initial load steps of the Newton solve')
     args = ap.parse_args()
     rows = []
     for grid in args.strong:

@@ -106,12 +106,16 @@ def iterations(sc, scheme, solver, load, steps, candidates=None, **kw):
 def main():
     p = demo_parser(__doc__)
     p.add_argument("--sizes", type=float, nargs="*",
-                   default=[2.5, 1.6, 1.0, 0.88])
-    p.add_argument("--hex", type=int, nargs="*", default=[24, 40])
-    p.add_argument("--solver", default="auto")
+                   default=[2.5, 1.6, 1.0, 0.88],
+                    help='gmsh element sizes of the tetrahedral node sets (meshes/cook3d.geo)')
+    p.add_argument("--hex", type=int, nargs="*", default=[24, 40],
+                    help='cells per side of the distorted hexahedral grids (PG against H1P0)')
+    p.add_argument("--solver", default="auto",
+                    help='linear solver of newton(): auto, direct or amg')
     p.add_argument("--load", type=float, default=0.25,
                    help="fraction of the Cook load (default 0.25)")
-    p.add_argument("--steps", type=int, default=2)
+    p.add_argument("--steps", type=int, default=2,
+                    help='load steps to reach --load')
     p.add_argument("--section", default="newton_3d",
                    help="benchmarks/README.md section of the table")
     p.add_argument("--candidates", type=int, help="PG's AMG near-null-"

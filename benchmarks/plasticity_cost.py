@@ -62,7 +62,8 @@ def iteration(model, basis, D):
 
 def main():
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--n", type=int, default=10)
+    ap.add_argument("--n", type=int, default=10,
+                    help='cells per side of the unit cube')
     args = ap.parse_args()
     n = args.n
     mesh = fem.MeshHex.init_tensor(*[np.linspace(0, 1, n + 1)] * 3)

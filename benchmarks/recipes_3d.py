@@ -134,5 +134,6 @@ if __name__ == "__main__":
     ap = demo_parser(__doc__)
     ap.add_argument("--geometries", nargs="+", default=["cook", "beam",
                                                         "hole", "hex"],
-                    choices=["cook", "beam", "hole", "hex"])
+                    choices=["cook", "beam", "hole", "hex"],
+                    help="which node sets to study: Cook's membrane, a cantilever, a plate with a hole (tetrahedra), a hexahedral grid")
     main(ap.parse_args().geometries)

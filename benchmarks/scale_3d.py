@@ -98,7 +98,8 @@ def main():
     import skfem_pg as pg
     p = demo_parser(__doc__)
     p.add_argument("--sizes", type=float, nargs="*",
-                   default=[0.05, 0.035, 0.025, 0.02])
+                   default=[0.05, 0.035, 0.025, 0.02],
+                    help='gmsh element sizes of the tetrahedral node sets, one process each')
     p.add_argument("--one", type=float, help=argparse_hide())
     args = p.parse_args()
     if args.one is not None:

@@ -87,11 +87,15 @@ def run(A, b, locs, name):
 def main():
     ap = demo_parser(__doc__)
     ap.add_argument("--sizes", type=float, nargs="+",
-                    default=[2.5, 1.6, 1.2, 1.0, 0.8])
-    ap.add_argument("--methods", nargs="+", default=["O1", "PG"])
+                    default=[2.5, 1.6, 1.2, 1.0, 0.8],
+                    help='gmsh element sizes of the 3-D Cook tetrahedra')
+    ap.add_argument("--methods", nargs="+", default=["O1", "PG"],
+                    help='discretizations whose tangents are solved: O1 and/or PG')
     ap.add_argument("--solvers", nargs="+",
-                    default=["pardiso", "superlu", "amg", "amg+12"])
-    ap.add_argument("--max-seconds", type=float, default=300.0)
+                    default=["pardiso", "superlu", "amg", "amg+12"],
+                    help='pardiso, superlu, amg (rigid-body modes only), amg+12 (with 12 random candidates)')
+    ap.add_argument("--max-seconds", type=float, default=300.0,
+                    help='skip a method whose predicted solve time exceeds this')
     args = ap.parse_args()
     warnings.filterwarnings("ignore", message="Indefinite matrix")
     solvers = [s for s in args.solvers

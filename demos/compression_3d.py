@@ -137,7 +137,8 @@ if __name__ == "__main__":
                     help="cells per side of the hexahedral grids")
     ap.add_argument("--tets", action="store_true",
                     help="the grids split into tetrahedra (PG kNN, O1)")
-    ap.add_argument("--steps", type=int, default=6)
+    ap.add_argument("--steps", type=int, default=6,
+                    help='load steps of the compression')
     ap.add_argument("--adaptive", action="store_true",
                     help="cut failed load steps instead of stopping")
     a = ap.parse_args()

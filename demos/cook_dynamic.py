@@ -165,7 +165,8 @@ if __name__ == "__main__":
     ap.add_argument("--steps", type=int, default=500,
                     help="Newmark steps over 0.12 ms (default 500, the "
                     "thesis')")
-    ap.add_argument("--variants", nargs="+", choices=list(VARIANTS))
+    ap.add_argument("--variants", nargs="+", choices=list(VARIANTS),
+                    help='which of the Fig. 7.12 variants to run (default: all)')
     ap.add_argument("--q0", type=float, default=Q0,
                     help="load amplitude [kN/mm] (default 10: the thesis' "
                     "10000 read as N/mm)")

@@ -146,7 +146,8 @@ def main(sizes=(8, 16, 32), results=None, out=None, ref_base=64):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 16, 32],
+                    help='elements per side of the Cook node sets')
     ap.add_argument("--full", action="store_true",
                     help="node sets 8, 16, 32, 64")
     a = ap.parse_args()

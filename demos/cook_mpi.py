@@ -57,17 +57,23 @@ def corner_w(mesh, u):
 
 def main():
     ap = demo_parser(__doc__)
-    ap.add_argument("--n", type=int, default=12)
-    ap.add_argument("--nz", type=int, default=3)
-    ap.add_argument("--load", type=float, default=4.0)
-    ap.add_argument("--steps", type=int, default=4)
-    ap.add_argument("--no-serial", action="store_true")
+    ap.add_argument("--n", type=int, default=12,
+                    help="cells per side in the membrane's plane")
+    ap.add_argument("--nz", type=int, default=3,
+                    help='cells through the thickness')
+    ap.add_argument("--load", type=float, default=4.0,
+                    help='dead load per unit area in +z on x = 48')
+    ap.add_argument("--steps", type=int, default=4,
+                    help='initial load steps of the distributed Newton')
+    ap.add_argument("--no-serial", action="store_true",
+                    help='skip the serial comparison on rank 0')
     ap.add_argument("--options", default="",
                     help="PETSc options for the KSP, e.g. '-ksp_type gmres'")
     ap.add_argument("--fe", action="store_true",
                     help="rank 0 also solves H1 (scikit-fem hexahedra, "
                     "sparse direct) on the same nodes")
-    ap.add_argument("--json", default=None)
+    ap.add_argument("--json", default=None,
+                    help='write the timings of rank 0 to this JSON file (benchmarks/mpi_scaling.py)')
     args = ap.parse_args()
     if args.quick:
         args.n, args.nz, args.steps = 4, 1, 1

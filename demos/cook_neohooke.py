@@ -139,9 +139,12 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1, results=None):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--sizes", type=float, nargs="+", default=[4, 2, 1])
-    ap.add_argument("--ref-size", type=float, default=1.0)
-    ap.add_argument("--ref-refine", type=int, default=1)
+    ap.add_argument("--sizes", type=float, nargs="+", default=[4, 2, 1],
+                    help='gmsh element sizes of the triangle node sets (meshes/cook.geo)')
+    ap.add_argument("--ref-size", type=float, default=1.0,
+                    help="gmsh element size of the T2 overkill's mesh")
+    ap.add_argument("--ref-refine", type=int, default=1,
+                    help="uniform refinements of the overkill's mesh")
     a = ap.parse_args()
     OUT = output_dir(a.out)
     if a.quick:

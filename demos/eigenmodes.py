@@ -101,9 +101,12 @@ def plot(mesh, spectra, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--nx", type=int, default=20)
-    ap.add_argument("--ny", type=int, default=10)
-    ap.add_argument("--distortion", type=float, default=0.0)
+    ap.add_argument("--nx", type=int, default=20,
+                    help='elements along the 2 x 1 block')
+    ap.add_argument("--ny", type=int, default=10,
+                    help='elements across the 2 x 1 block')
+    ap.add_argument("--distortion", type=float, default=0.0,
+                    help='random interior node distortion, in element sizes')
     a = ap.parse_args()
     OUT = output_dir(a.out)
     main(*((6, 3) if a.quick else (a.nx, a.ny)), a.distortion)

@@ -30,12 +30,15 @@ def output_dir(path=None, create=True):
 
 def demo_parser(doc, results=False):
     """The ``argparse`` parser of a demo or benchmark: its description is
-    the first line of ``doc``; ``--out`` (:func:`output_dir`), ``--quick``
+    the first paragraph of ``doc`` (a whole sentence), every option's
+    default is shown; ``--out`` (:func:`output_dir`), ``--quick``
     (the demo's seconds-long variant, run by the tests) and, with
     ``results``, ``--results`` (a markdown page whose section of this
     script :func:`update_results` rewrites)."""
     import argparse
-    ap = argparse.ArgumentParser(description=doc.split("\n")[0])
+    ap = argparse.ArgumentParser(
+        description=" ".join(doc.strip().split("\n\n")[0].split()),
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--quick", action="store_true",

@@ -308,7 +308,8 @@ if __name__ == "__main__":
     ap.add_argument("--overkill", type=int, default=3,
                     help="refinement of the H1P0 overkill (0: none)")
     ap.add_argument("--methods", nargs="+", choices=list(METHODS),
-                    metavar="METHOD")
+                    metavar="METHOD",
+                    help="formulations to run (default: the demo's selection)")
     ap.add_argument("--full", action="store_true",
                     help="n = 6 (the thesis' N = 6 splitting, on this mesh; "
                     "hours)")

@@ -137,8 +137,10 @@ def plot(mesh, res, runs, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--nx", type=int, default=64)
-    ap.add_argument("--ny", type=int, default=32)
+    ap.add_argument("--nx", type=int, default=64,
+                    help='elements along the block')
+    ap.add_argument("--ny", type=int, default=32,
+                    help="elements through the block's height")
     a = ap.parse_args()
     OUT = output_dir(a.out)
     main(*((8, 4) if a.quick else (a.nx, a.ny)), a.results)

@@ -166,7 +166,8 @@ def main(sizes=(4, 8), ref_n=12, results=None, out=None):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__, results=True)
-    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 8])
+    ap.add_argument("--sizes", type=int, nargs="+", default=[4, 8],
+                    help='n of the n x n x n/2 hexahedral node sets')
     ap.add_argument("--full", action="store_true",
                     help="sizes 4 8 12 16, reference 24 x 24 x 12")
     a = ap.parse_args()

@@ -92,7 +92,8 @@ def plot(results, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--n", type=int, default=12)
+    ap.add_argument("--n", type=int, default=12,
+                    help='elements per side of the patch')
     a = ap.parse_args()
     OUT = output_dir(a.out)
     main(6 if a.quick else a.n)

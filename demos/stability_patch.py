@@ -182,8 +182,10 @@ def plot(p, runs, fn):
 
 if __name__ == "__main__":
     ap = demo_parser(__doc__)
-    ap.add_argument("--periods", type=int, default=10)
-    ap.add_argument("--size", type=float, default=0.11)
+    ap.add_argument("--periods", type=int, default=10,
+                    help='breathing-mode periods integrated')
+    ap.add_argument("--size", type=float, default=0.11,
+                    help='gmsh element size of the quadrilaterals whose centroids are the particles')
     a = ap.parse_args()
     OUT = output_dir(a.out)
     main(*((1, 0.3) if a.quick else (a.periods, a.size)))

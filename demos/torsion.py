@@ -228,7 +228,8 @@ if __name__ == "__main__":
     ap.add_argument("--n", type=int, default=3,
                     help="n x n x 5n hexahedra (thesis: 16)")
     ap.add_argument("--methods", nargs="+", choices=list(THESIS),
-                    metavar="METHOD")
+                    metavar="METHOD",
+                    help="formulations of Table 7.4 to run (default: the demo's selection)")
     ap.add_argument("--full", action="store_true",
                     help="the thesis' 16 x 16 x 80 elements (hours)")
     a = ap.parse_args()

@@ -217,7 +217,8 @@ if __name__ == "__main__":
                     help="n = 7, the thesis' 1715 elements, and every "
                     "formulation of Table 7.5 (hours)")
     ap.add_argument("--methods", nargs="+", choices=list(METHODS),
-                    metavar="METHOD")
+                    metavar="METHOD",
+                    help="formulations of Table 7.5 to run (default: the demo's selection)")
     ap.add_argument("--max-angle", type=float, default=720.0,
                     help="where D2 stops if nothing fails (default 720)")
     ap.add_argument("--line-search", action="store_true",

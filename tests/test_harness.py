@@ -39,3 +39,37 @@ def test_benchmarks_load_the_demos_harness():
                          text=True, check=True,
                          cwd=os.path.join(ROOT, "benchmarks")).stdout
     assert out.strip() == os.path.join("demos", "harness.py")
+
+
+def test_every_script_option_has_help_and_shows_its_default():
+    """Every option of every demo and benchmark says what it is (the
+    harness' parser shows the defaults), and every script builds its
+    parser with the harness (``--out``, ``--quick``, the formatter)."""
+    import ast
+    import glob
+    missing, raw = [], []
+    for path in sorted(glob.glob(os.path.join(ROOT, "demos", "*.py"))
+                       + glob.glob(os.path.join(ROOT, "benchmarks", "*.py"))):
+        tree = ast.parse(open(path).read())
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Call):
+                continue
+            name = getattr(node.func, "attr", getattr(node.func, "id", ""))
+            if name == "add_argument" and "help" not in {
+                    k.arg for k in node.keywords}:
+                missing.append("{}:{}".format(os.path.basename(path),
+                                              node.lineno))
+            if name == "ArgumentParser" and not path.endswith("harness.py"):
+                raw.append(os.path.basename(path))
+    assert not missing and not raw, (missing, raw)
+    text = subprocess.run([sys.executable, os.path.join(ROOT, "demos",
+                                                        "punch.py"), "--help"],
+                          capture_output=True, text=True, check=True).stdout
+    assert "(default: 64)" in text and "elements along the block" in text
+    description = text.split("options:")[0].split("\n\n", 1)[1].strip()
+    assert description.endswith(".")  # a whole sentence, not a first line
+    for path in glob.glob(os.path.join(ROOT, "demos", "*.py")) + glob.glob(
+            os.path.join(ROOT, "benchmarks", "*.py")):
+        doc = ast.get_docstring(ast.parse(open(path).read()))
+        first = " ".join(doc.strip().split("\n\n")[0].split())
+        assert first.endswith((".", ":", ")", "?")), (path, first[-60:])
