@@ -119,3 +119,29 @@ def test_a_scalar_coefficient_is_evaluated_at_every_family():
     assert np.asarray(b.interpolate(k)).shape == b.dx.shape
     A, B = by_values.assemble(b, k=k), by_position.assemble(b)
     assert abs(A - B).max() <= 1e-12 * abs(B).max()
+
+
+def test_one_verbosity_convention(square, capsys, monkeypatch):
+    """``verbose`` is True, False or "auto" in newton, the integrators and
+    Scene.solve; "auto" (the default) is silent for a quick run and prints
+    from AUTO_SECONDS on."""
+    from skfem_pg import progress
+    from skfem_pg.formulations import Hyperelastic
+    mesh = square.with_boundaries({"left": lambda x: x[0] == 0,
+                                   "right": lambda x: x[0] == 1})
+    b = pg.FamilyBasis(mesh, dim=2)
+    model = Hyperelastic(b, materials.NeoHooke(1.0, 1.0))
+    f = pg.traction(b, "right", [0.0, 0.01])
+    pg.newton(model, f, D=b.get_dofs("left"))
+    pg.newmark(model, pg.lumped_mass(b, 1.0), 0.2, 0.1, f_ext=f,
+               D=b.get_dofs("left"))
+    assert capsys.readouterr().out == ""  # quick: silent by default
+    monkeypatch.setattr(progress, "AUTO_SECONDS", 0.0)
+    pg.newton(model, f, D=b.get_dofs("left"), steps=2)
+    assert capsys.readouterr().out.count("load ") == 2
+    pg.Scene("s", mesh, materials.NeoHooke(1.0, 1.0), clamped=["left"],
+             tractions={"right": [0.0, 0.01]}).solve("VCBCPBG V5m Unl")
+    assert "load 1.0000" in capsys.readouterr().out
+    with pytest.raises(ValueError, match="verbose must be True, False or "
+                       "'auto'"):
+        pg.newton(model, f, D=b.get_dofs("left"), verbose="loud")

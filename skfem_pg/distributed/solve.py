@@ -23,6 +23,7 @@ from . import petsc as pt
 from .comm import mpi
 from ..dofs import as_dofs
 from ..solvers.result import Result
+from ..progress import Echo
 from ..solvers.controls import NewtonControls
 from ..solvers.static import (LinearSolveFailed, load_stepping,
                               newton_iterations)
@@ -167,11 +168,7 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
 
     return load_stepping(model, step, algebra, pt.empty_vector(part), 0.0,
                          1.0 / opts.steps, opts,
-                         echo=print if part.rank == 0 else _silent)
-
-
-def _silent(*args, **kwargs):
-    pass
+                         echo=Echo(opts.verbose if part.rank == 0 else False))
 
 
 class PetscAlgebra:

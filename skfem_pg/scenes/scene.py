@@ -258,7 +258,7 @@ class Scene:
         return fe_traction(basis, name, t, mesh=mesh, what=what.format(name))
 
     # -- solving -------------------------------------------------------
-    def solve(self, scheme="PG", mesh=None, verbose=False, solver="auto",
+    def solve(self, scheme="PG", mesh=None, verbose="auto", solver="auto",
               tangent="consistent", tol=1e-9, comm=None, **basis_kwargs):
         """Solve with a thesis name (``"VCBCPBG V5sn UnlP0"``, ``"PBG
         IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
@@ -267,7 +267,9 @@ class Scene:
         an FE comparator of :func:`skfem_pg.registry.fe_names` (also as
         ``"FEM Q1P0"``);
         ``tol``: Newton's relative residual tolerance
-        (:func:`~skfem_pg.solvers.newton`).  Returns a :class:`Result`.
+        (:func:`~skfem_pg.solvers.newton`); ``verbose``: its progress
+        lines, ``True``, ``False`` or ``"auto"`` (from a few seconds on,
+        :mod:`skfem_pg.progress`).  Returns a :class:`Result`.
 
         ``comm`` (an MPI communicator): solve on its ranks with
         :mod:`skfem_pg.distributed` (PG displacement formulations Unl/U1,

@@ -18,6 +18,8 @@ from typing import Optional
 
 import numpy as np
 
+from ..progress import check_verbose
+
 
 class Controls:
     """What the records share: :meth:`of`."""
@@ -86,7 +88,9 @@ class NewtonControls(Controls):
         failed (:func:`~skfem_pg.solvers.static.newton_iterations`).  ``False``: full Newton
         increments, a failed iterate cuts the step.
     verbose
-        Print a line per load step (on rank 0 of a distributed run).
+        ``True``: a line per load step (on rank 0 of a distributed run);
+        ``False``: silent; ``"auto"``: the lines from a few seconds into
+        the run on (:mod:`skfem_pg.progress`).
     """
 
     steps: int = 1
@@ -96,11 +100,12 @@ class NewtonControls(Controls):
     adaptive: bool = True
     predictor: bool = True
     line_search: bool = False
-    verbose: bool = True
+    verbose: object = "auto"
 
     def __post_init__(self):
         check_controls(steps=self.steps, tol=self.tol, maxiter=self.maxiter,
                         min_step=self.min_step)
+        check_verbose(self.verbose)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -120,7 +125,8 @@ class NewmarkControls(Controls):
     output_every
         A record (and the callback) every this many converged steps.
     verbose
-        Print progress and cut steps.
+        Progress and cut steps: ``True``, ``False`` or ``"auto"``
+        (:mod:`skfem_pg.progress`).
     """
 
     beta: float = 0.25
@@ -131,12 +137,13 @@ class NewmarkControls(Controls):
     line_search: bool = False
     max_contact_passes: int = 20
     output_every: int = 1
-    verbose: bool = True
+    verbose: object = "auto"
 
     def __post_init__(self):
         if not (0 < self.beta and 0 < self.gamma):
             raise ValueError("beta and gamma must be positive")
         check_controls(tol=self.tol, maxiter=self.maxiter)
+        check_verbose(self.verbose)
         _positive_int(self.max_contact_passes, "max_contact_passes")
         _positive_int(self.output_every, "output_every")
 
@@ -158,20 +165,22 @@ class ExplicitControls(Controls):
         Stop with :class:`~skfem_pg.solvers.DynamicsError` when the
         relative energy balance error exceeds this.
     verbose
-        Print progress.
+        Progress: ``True``, ``False`` or ``"auto"``
+        (:mod:`skfem_pg.progress`).
     """
 
     safety: float = 0.8
     estimate_every: int = 100
     output_every: Optional[int] = None
     max_energy_error: float = 0.05
-    verbose: bool = True
+    verbose: object = "auto"
 
     def __post_init__(self):
         if not (np.isfinite(self.safety) and self.safety > 0):
             raise ValueError("safety must be a positive factor of the "
                              "stable step, got {!r}".format(self.safety))
         _positive_int(self.estimate_every, "estimate_every")
+        check_verbose(self.verbose)
         if self.output_every is not None:
             _positive_int(self.output_every, "output_every")
         if not self.max_energy_error > 0:

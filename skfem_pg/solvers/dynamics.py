@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import FamilyError, ParticleError
+from ..progress import Echo
 from .checkpoint import load as load_checkpoint
 from .static import padded_vector
 
@@ -229,12 +230,12 @@ class Progress:
     error."""
 
     def __init__(self, t_end, verbose, parts=10, stream=None):
-        self.t_end, self.verbose, self.parts = t_end, verbose, parts
-        self.next, self.t0 = 0, time.perf_counter()
-        self.stream = stream or sys.stdout
+        self.t_end, self.parts = t_end, parts
+        self.echo = Echo(verbose, stream)
+        self.next, self.t0 = 0, self.echo.t0
 
     def __call__(self, t, dt, steps, energies, force=False):
-        if not self.verbose:
+        if not self.echo.on:
             return
         frac = t / self.t_end if self.t_end > 0 else 1.0
         if not force and frac < self.next / self.parts - 1e-12:
@@ -250,7 +251,7 @@ class Progress:
                   e["kinetic"], e["internal_work"],
                   e["external_work"] + e["prescribed_work"],
                   e["contact_loss"], e["relative_error"]),
-              file=self.stream, flush=True)
+              file=self.echo.stream or sys.stdout, flush=True)
 
 
 def resume_run(path, model, energy, hist):

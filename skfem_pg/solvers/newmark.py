@@ -157,7 +157,8 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
     a = np.where(free, (fe[:n_u] - fi[:n_u]) / m, 0.0)
     energy = EnergyBalance(m, v, free, stored_energy(model, state))
     energy.D_c += hold_initial(walls, cand, x, v, a, m, held)
-    out = Recorder(model, energy, free, Progress(t_end, verbose), callback,
+    progress = Progress(t_end, verbose)
+    out = Recorder(model, energy, free, progress, callback,
                    times)
     hist = out.hist
     t, steps, step, cuts = 0.0, 0, float(dt), 0
@@ -185,9 +186,8 @@ def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
         if not ok:
             cuts += 1
             step = h / 2
-            if verbose:
-                print("  t {:.6g}: step {:.3g} failed ({}); halved".format(
-                    t + h, h, res), flush=True)
+            progress.echo("  t {:.6g}: step {:.3g} failed ({}); halved"
+                          .format(t + h, h, res))
             if step < dt_min:
                 raise DynamicsError(
                     "Newmark: no convergence at t = {:.6g} with the step "

@@ -21,6 +21,7 @@ from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
 from .controls import NewtonControls, check_controls
+from ..progress import Echo
 from .linear import linear_solver, submatrix
 from ..discretization.layout import is_family_basis
 
@@ -176,7 +177,7 @@ def newton(model, f_ext=None, D=None, u_D=None, u0=None, solver="auto",
 
 
 def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
-                  callback=None, every=None, echo=print):
+                  callback=None, every=None, echo=None):
     r"""The load-stepping loop of :func:`newton` and of the distributed
     :func:`skfem_pg.distributed.newton`: from the converged ``u`` at load
     factor ``lam`` to :math:`\lambda = 1`, first step ``dlam``.
@@ -191,8 +192,10 @@ def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
     and recorded; a failed one is halved, and :class:`ConvergenceError`
     is raised below ``options.min_step``, for fixed steps, or after
     :data:`MAX_LOAD_STEPS` (or 4 ``steps``) attempts.  ``prev`` is the
-    predictor's ``(load, x)`` of the step before.  Returns ``(x,
-    history)``, ``x`` serial."""
+    predictor's ``(load, x)`` of the step before; ``echo`` prints the
+    progress lines (default: :class:`~skfem_pg.progress.Echo` of
+    ``options.verbose``).  Returns ``(x, history)``, ``x`` serial."""
+    echo = Echo(options.verbose) if echo is None else echo
     history = []
     attempts, max_attempts = 0, max(MAX_LOAD_STEPS, 4 * options.steps)
     while lam < 1.0 - 1e-14:
@@ -211,8 +214,7 @@ def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
                 u, prev[1], (target - lam) / (lam - prev[0]))
         ok, uk, info, state = step(start, target)
         info.update(load=target, seconds=time.perf_counter() - t0)
-        if options.verbose:
-            echo(step_line(info, target, target - lam, ok), flush=True)
+        echo(step_line(info, target, target - lam, ok))
         f_int = info.pop("f_int", None)
         if ok:
             if hasattr(model, "commit"):  # history of a converged step
