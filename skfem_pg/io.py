@@ -1,5 +1,7 @@
 """VTU output of particle fields for ParaView (via meshio), and time
 series of them (``.pvd`` collections)."""
+from __future__ import annotations
+
 import os
 
 import numpy as np
@@ -8,7 +10,7 @@ import meshio
 from .discretization.layout import is_family_basis
 
 
-def write_vtu(filename, particles, **point_data):
+def write_vtu(filename: str, particles, **point_data) -> None:
     """Write particles (a :class:`~skfem_pg.Particles` or a
     :class:`~skfem_pg.FamilyBasis`) and their fields for ParaView.
 

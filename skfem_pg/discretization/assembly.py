@@ -33,11 +33,14 @@ element, ``j`` a quadrature point and ``i`` a scalar shape function — the
 same code assembles FE comparators.  Forms that use more than values and
 gradients (``hess`` ...) raise; use ``form.assemble(basis)`` for those.
 """
+from __future__ import annotations
+
 import numpy as np
 import scipy.sparse as sp
 import skfem as fem
 from skfem.assembly import BilinearForm, LinearForm
 from skfem.assembly.form.form import FormExtraParams
+from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField, ElementVector
 
 from .basis import FamilyBasis
@@ -459,7 +462,9 @@ def _assemble_linear(form, basis, view, kwargs):
 
 
 @kernel
-def assemble(form, basis, vbasis=None, **kwargs):
+def assemble(form: fem.assembly.form.Form, basis: AbstractBasis,
+             vbasis: AbstractBasis | None = None,
+             **kwargs) -> sp.csr_matrix | np.ndarray | float:
     """Assemble ``form`` on ``basis`` with batched local matrices.
 
     Works for :class:`FamilyBasis` and scikit-fem cell bases (scalar or

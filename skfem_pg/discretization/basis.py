@@ -33,6 +33,8 @@ assembly; the batched hot paths (:func:`skfem_pg.assemble`,
 ``interpolate``, the models) use the unpadded size groups of
 :mod:`skfem_pg.discretization.layout` instead.
 """
+from __future__ import annotations
+
 import copy
 import sys
 import warnings
@@ -52,6 +54,8 @@ from .particles import Particles, linear_elements
 from .quadrature import volume_weights
 from ..threads import kernel
 from ..naming import name_of
+from .families import Families
+from numpy.typing import ArrayLike
 
 #: PPG test derivatives at the masters (``test_shape``)
 TEST_SHAPES = tuple(TEST_GRADIENTS)
@@ -199,11 +203,19 @@ class FamilyBasis(AbstractBasis):
     """
 
     @kernel
-    def __init__(self, particles, families=None, shape="MTE1", bond=None,
-                 vc="auto", method="PBG", dim=None, weight_exponent="auto",
-                 vc_solver="auto", area_vectors=None, vc_exclude=None,
-                 test_shape="master", lme_mu=1.8, vc_boundary="min-norm",
-                 vc_tolerance=1e-8, distributed=None, weights="auto"):
+    def __init__(self, particles: Particles | fem.Mesh,
+                 families: str | Families | None = None,
+                 shape: str = "MTE1", bond: bool | None = None,
+                 vc: str | None = "auto", method: str = "PBG",
+                 dim: int | None = None,
+                 weight_exponent: float | str = "auto",
+                 vc_solver: str = "auto",
+                 area_vectors: np.ndarray | None = None,
+                 vc_exclude: ArrayLike | None = None,
+                 test_shape: str = "master", lme_mu: float = 1.8,
+                 vc_boundary: str = "min-norm",
+                 vc_tolerance: float | None = 1e-8, distributed=None,
+                 weights: str = "auto") -> None:
         particles = _as_particles(particles)
         spec = BasisSpec.resolve(
             particles, families=families, shape=shape, bond=bond, vc=vc,
@@ -217,7 +229,9 @@ class FamilyBasis(AbstractBasis):
             distributed=distributed), distributed)
 
     @classmethod
-    def from_spec(cls, particles, spec, area_vectors=None, distributed=None):
+    def from_spec(cls, particles: Particles | fem.Mesh, spec: BasisSpec,
+                  area_vectors: np.ndarray | None = None,
+                  distributed=None) -> "FamilyBasis":
         """The basis of a :class:`~skfem_pg.discretization.builder.BasisSpec`
         (the keyword constructor resolves one and calls the same builder)."""
         particles = _as_particles(particles)
@@ -286,8 +300,10 @@ class FamilyBasis(AbstractBasis):
         return self.method != "PBG"
 
     @classmethod
-    def from_name(cls, particles, name, families=None, area_vectors=None,
-                  distributed=None, **kwargs):
+    def from_name(cls, particles: Particles | fem.Mesh, name: str,
+                  families: str | Families | None = None,
+                  area_vectors: np.ndarray | None = None,
+                  distributed=None, **kwargs) -> "FamilyBasis":
         """A basis from a thesis name (Table 7.1), e.g.
         ``FamilyBasis.from_name(p, "VCBCPBG V5 Unl", dim=2)``; see
         :mod:`skfem_pg.naming`."""

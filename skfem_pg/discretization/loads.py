@@ -29,10 +29,15 @@ there is :math:`t\,|A^i_h|`, and at a 2-D corner the split of
 :math:`A^i_h` onto its two face normals is unique — every term of the
 face's resultant is fixed by the patch test.
 """
+from __future__ import annotations
+
 import warnings
+from typing import Callable
 
 import numpy as np
 import skfem as fem
+from numpy.typing import ArrayLike
+from skfem.assembly.basis import AbstractBasis
 
 from .layout import is_family_basis
 
@@ -98,7 +103,8 @@ def _facet_basis(basis, facets, what):
     return p._facet_basis(facets, vector=basis.ncomp is not None)
 
 
-def traction(basis, facets, t):
+def traction(basis: AbstractBasis, facets,
+             t: ArrayLike | Callable) -> np.ndarray:
     r"""Consistent nodal forces of a traction ``t`` on ``facets``, on a
     :class:`~skfem_pg.FamilyBasis` or a scikit-fem cell basis
     (:func:`fe_traction`).
@@ -148,7 +154,7 @@ def traction(basis, facets, t):
     return _resize(f, basis)
 
 
-def stress_load(basis, facets, P):
+def stress_load(basis: AbstractBasis, facets, P: ArrayLike) -> np.ndarray:
     r"""Nodal forces :math:`\bar P \cdot A^i_\Gamma` of a homogeneous nominal
     stress ``P`` (``(d, d)``) acting on ``facets``."""
     d = basis.particles.dim
@@ -190,7 +196,8 @@ def _area_correction(basis, facets):
     return dA * share
 
 
-def body_force(basis, b, rho=1.0):
+def body_force(basis: AbstractBasis, b: ArrayLike | Callable,
+               rho: float | ArrayLike = 1.0) -> np.ndarray:
     r"""Nodal forces :math:`\rho_0 b(X^i) V^i` of a body force ``b``
     (constant vector or callable of positions ``(dim, n)``)."""
     if not is_family_basis(basis):

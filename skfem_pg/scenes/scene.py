@@ -33,7 +33,10 @@ A :class:`Result` holds the displacements in scikit-fem numbering of its
 basis (``u``) whatever the formulation, its extra fields (``fields``) and
 the reaction forces (:meth:`Result.reaction`).
 """
+from __future__ import annotations
+
 import hashlib
+from typing import Sequence
 import time
 
 import numpy as np
@@ -86,8 +89,12 @@ class Scene:
 
     """
 
-    def __init__(self, name, mesh, material, clamped=(), prescribed=None,
-                 tractions=None, probes=None, steps=1, params=None):
+    def __init__(self, name: str, mesh: fem.Mesh, material,
+                 clamped: Sequence[str] = (),
+                 prescribed: dict | None = None,
+                 tractions: dict | None = None,
+                 probes: dict | None = None, steps: int = 1,
+                 params: dict | None = None) -> None:
         self.name, self.mesh, self.material = name, mesh, material
         self.clamped = tuple(clamped)
         self.prescribed = prescribed or {}
@@ -258,8 +265,10 @@ class Scene:
         return fe_traction(basis, name, t, mesh=mesh, what=what.format(name))
 
     # -- solving -------------------------------------------------------
-    def solve(self, scheme="PG", mesh=None, verbose="auto", solver="auto",
-              tangent="consistent", tol=1e-9, comm=None, **basis_kwargs):
+    def solve(self, scheme: str = "PG", mesh: fem.Mesh | None = None,
+              verbose: bool | str = "auto", solver: str = "auto",
+              tangent: str = "consistent", tol: float = 1e-9, comm=None,
+              **basis_kwargs) -> Result:
         """Solve with a thesis name (``"VCBCPBG V5sn UnlP0"``, ``"PBG
         IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
         basis options), ``"PG"`` (the displacement formulation;

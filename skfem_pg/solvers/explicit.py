@@ -33,13 +33,18 @@ compressed point shrank since), and estimated again every
 ``max_energy_error`` stops with :class:`DynamicsError` — the signature of
 an unstable step — instead of returning garbage.
 """
+from __future__ import annotations
+
 import contextlib
+from typing import Callable
 import time
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 from scipy.sparse.linalg import eigsh
 
+from ..formulations.protocol import Model
 from ..dofs import as_dofs
 from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
@@ -131,9 +136,16 @@ def stable_time_step(model, m, x=None, free=None, safety=0.8):
     return safety * 2.0 / w
 
 
-def central_difference(model, m, t_end, f_ext=None, D=None, u_D=None,
-                       u0=None, v0=None, dt=None, wall=None, callback=None,
-                       checkpoint=None, resume=None, controls=None, **kw):
+def central_difference(model: Model, m: ArrayLike, t_end: float,
+                       f_ext: ArrayLike | Callable | None = None, D=None,
+                       u_D: ArrayLike | Callable | None = None,
+                       u0: ArrayLike | None = None,
+                       v0: ArrayLike | None = None,
+                       dt: float | None = None, wall=None,
+                       callback: Callable | None = None, checkpoint=None,
+                       resume: str | None = None,
+                       controls: ExplicitControls | None = None,
+                       **kw) -> Trajectory:
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by central differences.
 

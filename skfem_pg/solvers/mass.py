@@ -13,8 +13,12 @@ The time integrators (:mod:`~skfem_pg.solvers.newmark`,
 :mod:`~skfem_pg.solvers.explicit`) take the mass as this vector, one entry
 per displacement dof in scikit-fem's interleaved numbering.
 """
+from __future__ import annotations
+
 import numpy as np
 import skfem as fem
+from numpy.typing import ArrayLike
+from skfem.assembly.basis import AbstractBasis
 from skfem.helpers import dot
 
 from ..discretization.layout import is_family_basis
@@ -25,7 +29,8 @@ def _mass_form(u, v, w):
     return w.rho * dot(u, v)
 
 
-def lumped_mass(basis, rho):
+def lumped_mass(basis: AbstractBasis,
+                rho: float | ArrayLike) -> np.ndarray:
     """The diagonal mass, one entry per dof of ``basis`` (length
     ``basis.N``).
 

@@ -25,11 +25,16 @@ initial ``dt``.  Below ``dt_min`` the run stops with
 (the failure angle of a twisted prism, thesis 7.3.6).  The history of a
 plastic material is committed after each converged step.
 """
+from __future__ import annotations
+
 import time
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
+from numpy.typing import ArrayLike
 
+from ..formulations.protocol import Model
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
 from .checkpoint import Every
@@ -77,9 +82,14 @@ class _Inertial:
         return K + sp.diags(diag)
 
 
-def newmark(model, m, t_end, dt, f_ext=None, D=None, u_D=None, u0=None,
-            v0=None, solver="auto", wall=None, callback=None,
-            checkpoint=None, resume=None, controls=None, **kw):
+def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
+            f_ext: ArrayLike | Callable | None = None, D=None,
+            u_D: ArrayLike | Callable | None = None,
+            u0: ArrayLike | None = None, v0: ArrayLike | None = None,
+            solver: str | Callable = "auto", wall=None,
+            callback: Callable | None = None, checkpoint=None,
+            resume: str | None = None,
+            controls: NewmarkControls | None = None, **kw) -> Trajectory:
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by Newmark's method (module docstring).
 

@@ -13,10 +13,15 @@ converged one.  A step is cut in half when Newton diverges, exceeds
 halving the increment); a :class:`ConvergenceError` names the load factor
 once the step would fall below ``min_step``.
 """
+from __future__ import annotations
+
 import time
+from typing import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 
+from ..formulations.protocol import Model
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
@@ -64,9 +69,13 @@ def condensed_solver(kind, basis, I, extra_fields=False):
                          else I % locs.shape[0])
 
 
-def newton(model, f_ext=None, D=None, u_D=None, u0=None, solver="auto",
-           load0=0.0, callback=None, checkpoint=None, resume=None,
-           controls=None, **kw):
+def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
+           u_D: ArrayLike | Callable | None = None,
+           u0: ArrayLike | None = None, solver: str | Callable = "auto",
+           load0: float = 0.0, callback: Callable | None = None,
+           checkpoint=None, resume: str | None = None,
+           controls: NewtonControls | None = None,
+           **kw) -> tuple[np.ndarray, list]:
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
