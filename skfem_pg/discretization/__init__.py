@@ -22,6 +22,7 @@ systems.
                            arrays behind scikit-fem's basis interface
 ``assembly``, ``forms``    batched assembly; the fast-path decorators
 ``loads``                  tractions, stress and body loads on FE and PG bases
+``coefficients``           piecewise (per-cell) coefficients at the members
 =========================  ====================================================
 """
 from .particles import Particles

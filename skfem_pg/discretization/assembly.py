@@ -244,6 +244,15 @@ def check_coefficients(basis, kwargs):
                     "basis.interpolate(u) of this basis".format(
                         k, shape[-2:], shape, nf, m, basis.N))
         elif isinstance(v, np.ndarray) and v.ndim == 1 \
+                and basis.mesh is not None \
+                and v.shape[0] == basis.mesh.nelements != basis.N:
+            raise ValueError(
+                "form coefficient {!r} has one value per cell ({}); a "
+                "FamilyBasis integrates at its family members: evaluate it "
+                "there with skfem_pg.discretization.coefficients."
+                "cell_values_at_members(basis, {}) (an interface family "
+                "then sees both sides)".format(k, v.shape[0], k))
+        elif isinstance(v, np.ndarray) and v.ndim == 1 \
                 and v.shape[0] != basis.N:
             raise ValueError(
                 "form coefficient {!r} has {} entries, this FamilyBasis {} "
