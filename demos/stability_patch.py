@@ -1,4 +1,5 @@
-"""Stability of a free, randomly discretized patch (seed 002, Figs. 2–3).
+"""Stability of a free, randomly discretized patch (Ganzenmüller,
+Hiermaier & May, Figs. 2–3).
 
 A square patch (E = 1, nu = 0.3, rho = 1, neo-Hooke) discretized by the
 centroids of about 450 irregular gmsh quadrilaterals (volumes = quad

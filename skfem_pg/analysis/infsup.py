@@ -1,5 +1,5 @@
 r"""Numerical inf-sup test (Chapelle & Bathe 1993; thesis 7.2.5,
-(7.10)–(7.15); seed 003, (3.52)–(3.60)).
+(7.10)–(7.15); Quak 2011, (3.52)–(3.60)).
 
 For the displacement space :math:`U_h` and the pressure space :math:`P_h` a
 formulation induces, the inf-sup value is :math:`\tilde\beta =

@@ -1,5 +1,5 @@
 r"""Local maximum-entropy (LME) shape-function derivatives at the masters
-(Arroyo & Ortiz; seed 003, (2.26)–(2.30)), a test-function option of PPG.
+(Arroyo & Ortiz; Quak 2011, (2.26)–(2.30)), a test-function option of PPG.
 
 At the master :math:`x = X^k` of family ``k`` with members ``a``:
 
