@@ -10,6 +10,7 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 ``preprocess``, ``assemble``, ``solve`` (as in
 :attr:`skfem_pg.scenes.Result.times`).
 """
+import argparse
 import os
 
 from skfem_pg import threads
@@ -28,6 +29,18 @@ def output_dir(path=None, create=True):
     return path
 
 
+class _ShowDefaults(argparse.ArgumentDefaultsHelpFormatter):
+    """argparse's default display, except where the help text says the
+    default itself or there is none to say (flags, ``None``)."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text or action.default in (None, False) \
+                or action.default is argparse.SUPPRESS:
+            return text
+        return super()._get_help_string(action)
+
+
 def demo_parser(doc, results=False):
     """The ``argparse`` parser of a demo or benchmark: its description is
     the first paragraph of ``doc`` (a whole sentence), every option's
@@ -35,10 +48,9 @@ def demo_parser(doc, results=False):
     (the demo's seconds-long variant, run by the tests) and, with
     ``results``, ``--results`` (a markdown page whose section of this
     script :func:`update_results` rewrites)."""
-    import argparse
     ap = argparse.ArgumentParser(
         description=" ".join(doc.strip().split("\n\n")[0].split()),
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter)
+        formatter_class=_ShowDefaults)
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
     ap.add_argument("--quick", action="store_true",
