@@ -21,7 +21,8 @@ from .discretization import (particles, families, shape, corrections,
                              loads)
 from .scenes import meshing, reference
 from .errors import (ParticleError, FamilyError, CorrectionError,
-                     UnsupportedMeshError, SlowAssemblyWarning)
+                     UnsupportedMeshError, SlowAssemblyWarning,
+                     MixedBasisWarning)
 from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
@@ -35,6 +36,7 @@ __version__ = "0.1.0"
 
 __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "BilinearForm", "LinearForm", "SlowAssemblyWarning",
+           "MixedBasisWarning",
            "block_pattern", "traction", "stress_load", "body_force",
            "write_vtu", "discretization", "formulations", "materials",
            "solvers", "analysis", "scenes", "families", "shape",

@@ -35,6 +35,12 @@ class SlowAssemblyWarning(UserWarning):
     far slower than :func:`skfem_pg.assemble`."""
 
 
+class MixedBasisWarning(UserWarning):
+    """A form couples two family bases of different component counts on
+    the same particles (a displacement–pressure pair): an equal-order PG
+    pair that fails the inf-sup condition."""
+
+
 def describe_particle(index, x):
     """``'particle 12 at (0.5, 1.25)'`` — used in error messages."""
     pos = ", ".join("{:.6g}".format(c) for c in x)

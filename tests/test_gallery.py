@@ -216,3 +216,27 @@ def test_two_materials_evaluated_per_bond():
     assert np.abs(per_bond).max() < np.abs(right).max()
     with pytest.raises(ValueError, match="cell_values_at_members"):
         conduction.assemble(basis, k=k_cells)
+
+
+def test_an_equal_order_pg_pressure_pair_is_flagged():
+    """ex36's mixed displacement–pressure problem with both bases swapped
+    diverges to NaN (equal-order PG u–p pairs fail the inf-sup condition):
+    assembling the coupling form warns and names the package's mixed
+    formulations instead."""
+    from skfem.helpers import div
+    mesh = fem.MeshQuad.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    particles = pg.Particles.from_mesh(mesh)
+    ubasis = pg.FamilyBasis(particles, dim=2)
+    pbasis = pg.FamilyBasis(particles)
+
+    @fem.BilinearForm
+    def coupling(u, q, w):
+        return div(u) * q
+
+    with pytest.warns(pg.MixedBasisWarning, match="IUnlP0"):
+        B = pg.assemble(coupling, ubasis, pbasis)
+    assert B.shape == (pbasis.N, ubasis.N)
+    fe_u = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", pg.MixedBasisWarning)
+        coupling.assemble(fe_u, fe_u.with_element(fem.ElementQuad0()))

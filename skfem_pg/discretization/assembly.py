@@ -43,7 +43,7 @@ from skfem.assembly.form.form import FormExtraParams
 from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField, ElementVector
 
-from .basis import FamilyBasis
+from .basis import FamilyBasis, warn_equal_order_mixed
 from .shape.common import chunks
 from ..threads import kernel
 
@@ -493,6 +493,9 @@ def assemble(form: fem.assembly.form.Form, basis: AbstractBasis,
     if vbasis is None:
         test = getattr(basis, "test", None)
         vbasis = basis if test is None else test
+    elif getattr(vbasis, "families", None) is getattr(basis, "families",
+                                                       False):
+        warn_equal_order_mixed(basis, vbasis)  # else the generic path warns
     view = batched_view(basis)
     if vbasis is basis:
         vview = view

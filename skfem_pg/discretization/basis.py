@@ -49,7 +49,7 @@ from . import petrov
 from .builder import TEST_GRADIENTS, BasisSpec
 from .corrections import family_radii
 from ..dofs import as_dofs
-from ..errors import SlowAssemblyWarning
+from ..errors import MixedBasisWarning, SlowAssemblyWarning
 from .particles import Particles, linear_elements
 from .quadrature import volume_weights
 from ..threads import kernel
@@ -627,6 +627,31 @@ def _as_particles(particles):
     return particles
 
 
+def warn_equal_order_mixed(ubasis, vbasis):
+    """Warn (:class:`~skfem_pg.errors.MixedBasisWarning`) when a form
+    couples two family bases of different component counts on the same
+    particles — a displacement–pressure pair of equal order, which fails
+    the inf-sup condition (thesis 7.2.3; scikit-fem's mixed u–p example
+    with both bases swapped diverges to NaN)."""
+    if not (isinstance(ubasis, FamilyBasis)
+            and isinstance(vbasis, FamilyBasis)
+            and ubasis.ncomp != vbasis.ncomp):
+        return
+    pu, pv = ubasis.particles, vbasis.particles
+    if pu is pv or (pu.n == pv.n and np.array_equal(pu.x, pv.x)):
+        warnings.warn(
+            "a form couples a {}-component and a {}-component FamilyBasis "
+            "on the same particles: an equal-order PG displacement–"
+            "pressure pair fails the inf-sup condition and its Newton "
+            "iterations diverge.  Use the package's mixed formulations, "
+            "which carry pressures per family or condensed nodal ones: "
+            "Scene(...).solve('VCBCPBG V5m IUnlP0') or "
+            "'... Unl+P1C', or skfem_pg.formulations.IncompressibleP0 "
+            "with materials.NeoHookeIsoVol".format(
+                ubasis.ncomp or 1, vbasis.ncomp or 1),
+            MixedBasisWarning, stacklevel=4)
+
+
 def _check_generic_assembly(basis, frame):
     """Refuse scikit-fem's generic assembly where it would silently build
     the wrong thing on a Petrov–Galerkin basis, and say that it is slow.
@@ -655,6 +680,8 @@ def _check_generic_assembly(basis, frame):
         return
     loc = frame.f_locals
     u, v = loc.get("ubasis", basis), loc.get("vbasis", basis)
+    if v is not u and u is basis:  # once per form, from the trial side
+        warn_equal_order_mixed(u, v)
     if not isinstance(form, fem.LinearForm):  # bilinear (or trilinear)
         if isinstance(u, FamilyBasis) and u.trial is not None:
             raise ValueError(
