@@ -14,6 +14,7 @@ import hashlib
 import os
 import re
 import tempfile
+import time
 import warnings
 import zipfile
 
@@ -189,11 +190,16 @@ def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
                           "({}: {}); recomputing it".format(
                               fn, type(err).__name__, err))
     if verbose:
-        print("  computing the {} overkill reference on {} elements ..."
-              .format(method, mesh.nelements), flush=True)
+        print("  computing the {} overkill reference on {} elements (a "
+              "first-run cost: it is cached in {}) ...".format(
+                  method, mesh.nelements, cache_dir()), flush=True)
+    t0 = time.perf_counter()
     res = scene.solve(method, mesh=mesh, **solve_kwargs)
     _store(fn, p=mesh.p, t=mesh.t, u=res.u,
            **{"probe_" + k: v for k, v in res.probes.items()})
+    if verbose:
+        print("  overkill computed and cached in {:.1f} s".format(
+            time.perf_counter() - t0), flush=True)
     return Reference(mesh, method, res.u, res.probes)
 
 
@@ -222,6 +228,9 @@ def linear_cook(lam, mu, sizes=(64, 128), point=(48.0, 52.0),
                           "recomputing it".format(fn, type(err).__name__,
                                                   err))
     form = linear_elasticity(lam, mu)
+    if verbose:
+        print("  computing the linear Cook Q2 reference (a first-run cost: "
+              "it is cached in {}) ...".format(cache_dir()), flush=True)
     vals = []
     for n in sizes:
         m = cook_membrane(n)
