@@ -46,7 +46,7 @@ from skfem.element import DiscreteField
 
 from . import builder
 from . import petrov
-from .builder import TEST_GRADIENTS, BasisSpec
+from .builder import BasisSpec
 from .corrections import family_radii
 from ..dofs import as_dofs
 from ..errors import MixedBasisWarning, SlowAssemblyWarning
@@ -56,9 +56,6 @@ from ..threads import kernel
 from ..naming import name_of
 from .families import Families
 from numpy.typing import ArrayLike
-
-#: PPG test derivatives at the masters (``test_shape``)
-TEST_SHAPES = tuple(TEST_GRADIENTS)
 
 
 #: PBG quadrature weights :math:`w_{kj} = V^k V^j / V_H^k` (4.30), the

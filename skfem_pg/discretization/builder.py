@@ -276,8 +276,7 @@ class _Context:
 
     @property
     def surface(self):
-        p = self.particles
-        return p.surface_area_vectors() if p.mesh is not None else None
+        return surface_of(self.particles)
 
     def phi(self, variant):
         p = self.particles
@@ -350,6 +349,13 @@ CORRECTIONS = {
     ("PBG", 2): _second_order_pbg,
     ("PPG1", 2): _second_order_ppg1,
 }
+
+
+def surface_of(particles):
+    """The area vectors over the true surface (zero on an FE–PG
+    interface), or ``None`` for particles without a mesh."""
+    return (particles.surface_area_vectors() if particles.mesh is not None
+            else None)
 
 
 def area_vectors_of(particles, area_vectors):
@@ -434,8 +440,7 @@ def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
         dx = petrov.quadrature_weights(V, fam)
         Gt = np.zeros_like(G)
         Gt[:, 0] = TEST_GRADIENTS[spec.test_shape](particles, fam, G, spec)
-        mem, mask = fam.padded()
-        dx_t = np.zeros_like(V[mem] * mask)
+        dx_t = np.zeros(fam.padded()[0].shape)  # the masters' weights only
         dx_t[:, 0] = V[fam.masters]
     else:
         dx = weight_rule(spec.weights)(V, fam)
@@ -478,8 +483,7 @@ def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
         Gs, report = vc_solve(
             Gs, dxs, x, V, subs, area, phis, variant=spec.vc,
             solver=spec.vc_solver, boundary=spec.vc_boundary,
-            surface=(particles.surface_area_vectors()
-                     if particles.mesh is not None else None),
+            surface=surface_of(particles),
             index=[g.families for g in L])
         timings["vc"] = time.perf_counter() - t0
     check_correction(Gs, x, subs, report, spec.vc_tolerance,
@@ -515,7 +519,7 @@ def build(particles, spec, area_vectors=None, distributed=None):
     return stages(particles, fam, spec, area_vectors, vc_solve, timings)
 
 
-__all__ = ["BasisArrays", "BasisSpec", "CORRECTIONS", "METHODS",
+__all__ = ["BasisArrays", "BasisSpec", "CORRECTIONS", "METHODS", "surface_of",
            "TEST_GRADIENTS", "VC_VARIANTS", "area_vectors_of", "build",
            "check_family_sizes", "distributed_supports", "make_families",
            "trial_gradients"]

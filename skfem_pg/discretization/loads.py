@@ -83,15 +83,23 @@ def fe_traction(basis, facets, t, what="traction t", mesh=None):
     else:
         t = _constant_of(t, nc, what)
 
+    return _traction_form(t, nc, what).assemble(fb)
+
+
+def _traction_form(t, nc, what, origin=0.0):
+    """The linear form :math:`\int_\Gamma N_i\, t\, d\Gamma` of a
+    constant traction (checked) or a callable one, which sees the facet
+    points shifted by ``origin``; ``nc`` components (``None``: scalar)."""
     def load(v, w):
-        tv = call_user(t, w.x, what) if callable(t) else t
+        tv = call_user(t, np.asarray(w.x) + origin, what) if callable(t) \
+            else t
         if nc is None:
             return tv * v
         tv = np.asarray(tv, dtype=float)
         if tv.ndim == 1:
             tv = tv[:, None, None]
         return sum(tv[a] * v[a] for a in range(nc))
-    return fem.LinearForm(load).assemble(fb)
+    return fem.LinearForm(load)
 
 
 def _facet_basis(basis, facets, what):
@@ -117,7 +125,6 @@ def traction(basis: AbstractBasis, facets,
     if not is_family_basis(basis):
         return fe_traction(basis, facets, t)
     fb = _facet_basis(basis, facets, "traction")
-    vector = basis.ncomp is not None
     # the facet basis is local (Particles.facet_origin); t sees global x
     origin = basis.particles.facet_origin.reshape(-1, 1, 1)
     if callable(t):
@@ -126,19 +133,8 @@ def traction(basis: AbstractBasis, facets,
         warn_if_zero(tq, "the traction t(x)")
     else:
         t = _constant(t, basis, "traction t")
-
-    @fem.LinearForm
-    def load(v, w):
-        tv = (call_user(t, np.asarray(w.x) + origin, "the traction t(x)")
-              if callable(t) else t)
-        if vector:
-            tv = np.asarray(tv, dtype=float)
-            if tv.ndim == 1:
-                tv = tv[:, None, None]
-            return sum(tv[a] * v[a] for a in range(v.shape[0]))
-        return tv * v
-
-    f = load.assemble(fb)
+    f = _traction_form(t, basis.ncomp, "the traction t(x)",
+                       origin).assemble(fb)
     dA = _area_correction(basis, facets)
     if dA is not None:  # |A_h| - |A| times the traction at the particles
         A = basis.particles.area_vectors(facets)
