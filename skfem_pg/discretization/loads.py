@@ -87,7 +87,7 @@ def fe_traction(basis, facets, t, what="traction t", mesh=None):
 
 
 def _traction_form(t, nc, what, origin=0.0):
-    """The linear form :math:`\int_\Gamma N_i\, t\, d\Gamma` of a
+    r"""The linear form :math:`\int_\Gamma N_i\, t\, d\Gamma` of a
     constant traction (checked) or a callable one, which sees the facet
     points shifted by ``origin``; ``nc`` components (``None``: scalar)."""
     def load(v, w):
