@@ -12,6 +12,8 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 """
 import argparse
 import os
+import shutil
+import tempfile
 
 from skfem_pg import threads
 
@@ -41,11 +43,12 @@ class _ShowDefaults(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action)
 
 
-def demo_parser(doc, results=False):
+def demo_parser(doc, results=False, quick=True):
     """The ``argparse`` parser of a demo or benchmark: its description is
     the first paragraph of ``doc`` (a whole sentence), every option's
     default is shown; ``--out`` (:func:`output_dir`), ``--quick``
-    (the demo's seconds-long variant, run by the tests) and, with
+    (the demo's seconds-long variant, run by the tests; not with
+    ``quick=False``, for a script that has none) and, with
     ``results``, ``--results`` (a markdown page whose section of this
     script :func:`update_results` rewrites)."""
     ap = argparse.ArgumentParser(
@@ -53,15 +56,33 @@ def demo_parser(doc, results=False):
         formatter_class=_ShowDefaults)
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
-    ap.add_argument("--quick", action="store_true",
-                    help="a run of seconds on small node sets (what "
-                    "tests/test_demos.py runs); the numbers it prints are "
-                    "not the demo's claims")
+    if quick:
+        ap.add_argument("--quick", action="store_true",
+                        help="a run of seconds on small node sets (what "
+                        "tests/test_demos.py runs); the numbers it prints "
+                        "are not the demo's claims")
     if results:
         ap.add_argument("--results", help="markdown page whose section of "
                         "this script is rewritten (e.g. "
                         "benchmarks/README.md)")
     return ap
+
+
+def write_atomically(path, text):
+    """Write ``text`` to ``path`` through a temporary file in the same
+    folder and ``os.replace``: the page is never half written, and keeps
+    its permissions."""
+    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)),
+                               suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(text)
+        if os.path.exists(path):
+            shutil.copymode(path, tmp)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
 
 
 def update_results(path, section, text):
@@ -84,8 +105,7 @@ def update_results(path, section, text):
             new = head + block + rest.split(end, 1)[1]
         else:
             new = old.rstrip() + "\n\n" + block + "\n"
-        with open(path, "w") as fh:
-            fh.write(new)
+        write_atomically(path, new)
     except OSError as err:
         print("could not update {} ({})".format(path, err))
         return None

@@ -73,3 +73,63 @@ def test_every_script_option_has_help_and_shows_its_default():
         doc = ast.get_docstring(ast.parse(open(path).read()))
         first = " ".join(doc.strip().split("\n\n")[0].split())
         assert first.endswith((".", ":", ")", "?")), (path, first[-60:])
+
+
+def _run_times():
+    """``benchmarks/run_times.py`` as a module (it imports ``harness``
+    through ``benchmarks/harness.py``)."""
+    sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
+    try:
+        spec = importlib.util.spec_from_file_location(
+            "run_times", os.path.join(ROOT, "benchmarks", "run_times.py"))
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        sys.path.remove(os.path.join(ROOT, "benchmarks"))
+    return module
+
+
+def _section(path, name):
+    text = open(path).read()
+    begin, end = "<!-- begin {} -->".format(name), \
+        "<!-- end {} -->".format(name)
+    assert begin in text and end in text, (path, name)
+    return text.split(begin, 1)[1].split(end, 1)[0]
+
+
+def test_quoted_times_are_the_measured_ones():
+    """The README's and the getting-started page's times paragraph and
+    the demo table of ``benchmarks/README.md`` are what
+    ``benchmarks/run_times.py`` renders from its stored measurements
+    (a hand edit of a time fails here), and every demo and benchmark
+    script has its row."""
+    rt = _run_times()
+    store = rt.load()
+    readme = _section(rt.PAGES["readme"], "readme_times")
+    assert readme == _section(rt.PAGES["getting_started"], "readme_times")
+    assert rt.render_readme(store) is not None
+    assert readme.strip().startswith(rt.render_readme(store))
+    assert _section(rt.PAGES["benchmarks"], "run_times").strip() \
+        .startswith(rt.render_table(store))
+    scripts = {" ".join(cmd) for _, cmd, *_ in rt.SCRIPTS}
+    for folder in ("demos", "benchmarks"):
+        for name in os.listdir(os.path.join(ROOT, folder)):
+            if name.endswith(".py") and name not in ("harness.py",
+                                                     "run_times.py"):
+                assert "{}/{}".format(folder, name) in scripts, name
+
+
+def test_pages_are_written_atomically(tmp_path):
+    """``update_results`` replaces a section through a temporary file:
+    the page keeps its other text and its permissions, no temporary file
+    is left."""
+    update_results = _harness().update_results
+    page = tmp_path / "page.md"
+    page.write_text("head\n<!-- begin a -->\nold\n<!-- end a -->\ntail\n")
+    page.chmod(0o644)
+    update_results(str(page), "a", "new")
+    text = page.read_text()
+    assert "new" in text and "old" not in text and text.startswith("head")
+    assert text.rstrip().endswith("tail")
+    assert oct(page.stat().st_mode & 0o777) == "0o644"
+    assert os.listdir(tmp_path) == ["page.md"]

@@ -1,0 +1,313 @@
+"""Run times of the demos, the benchmarks and the README's commands,
+measured by running them, so that no page quotes a time by hand.
+
+Each selected script runs at its default settings in a subprocess with an
+empty cache (``SKFEM_PG_CACHE`` and ``SKFEM_PG_OUT`` in a temporary
+folder): that is its first run.  A script that left something in the cache
+runs once more: its cached run.  The test commands run in the source tree.
+The measurements go to ``benchmarks/run_times.json`` (replaced atomically;
+a measurement is kept until its script is measured again), from which this
+script renders the demo table of ``benchmarks/README.md`` (section
+``run_times``) and the times paragraph of ``README.md`` and
+``docs/getting_started.md`` (section ``readme_times``, the same text in
+both; ``tests/test_harness.py`` checks that they match the file).
+
+Examples::
+
+    python benchmarks/run_times.py --only cook_neohooke tests
+    python benchmarks/run_times.py --below 180   # everything quoted < 3 min
+    python benchmarks/run_times.py --render      # re-render, run nothing
+
+Rows whose script has not been measured this way yet show the time
+measured by hand when their issue closed, marked as such.
+"""
+import datetime
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+from harness import (demo_parser, markdown_table, update_results,
+                     write_atomically)
+
+from skfem_pg import threads
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+STORE = os.path.join(ROOT, "benchmarks", "run_times.json")
+PAGES = {"benchmarks": os.path.join(ROOT, "benchmarks", "README.md"),
+         "readme": os.path.join(ROOT, "README.md"),
+         "getting_started": os.path.join(ROOT, "docs", "getting_started.md")}
+
+#: (key, command after ``python``, what it shows, the time measured by
+#: hand when its issue closed, that time in seconds — what ``--below``
+#: selects by)
+SCRIPTS = [
+    ("cook_neohooke", ["demos/cook_neohooke.py"],
+     "main job: 2-D Cook, PG vs T1, error vs time, consistent vs FD "
+     "tangent", "13 s first run, 8 s after", 13),
+    ("cook_3d", ["demos/cook_3d.py"],
+     "3-D Cook, neo-Hooke: time to 1 % and 0.3 % of PG (kNN and the thesis "
+     "recipe), O1, O2 on gmsh tets, H1P0 on hex grids",
+     "10 min (first run: 18 min, the H2 references)", 1080),
+    ("compression_3d", ["demos/compression_3d.py"],
+     "a block clamped on its loaded faces, compressed 30 %: PG vs H1 (O1 "
+     "with `--tets`), completion, min J, inverted cells", "5 min", 300),
+    ("punch", ["demos/punch.py"],
+     "compress until failure: Q1 vs VC PBG Unl, inverted cells", "33 s", 33),
+    ("plate_hole", ["demos/plate_hole.py"],
+     "thesis 7.3.8: PPG around a hole coupled to Q1, σ_xx vs overkill and "
+     "Kirsch", "80 s (first run)", 80),
+    ("coupling", ["demos/coupling.py"],
+     "FE–PG coupling through shared nodes", "30 s", 30),
+    ("patch_test", ["demos/patch_test.py"], "Table 7.2", "8 s", 8),
+    ("quadratic_patch_test", ["demos/quadratic_patch_test.py"],
+     "Table 7.3", "4 s", 4),
+    ("eigenmodes", ["demos/eigenmodes.py"],
+     "free-block spectra (Fig. 7.6)", "4 s", 4),
+    ("stability_patch", ["demos/stability_patch.py"],
+     "Ganzenmüller et al.'s stability case", "7 s", 7),
+    ("cook_membrane", ["demos/cook_membrane.py"],
+     "linear Cook, convergence", "24 s first run, 5 s after", 24),
+    ("cook_incompressible", ["demos/cook_incompressible.py"],
+     "Cook, ν ≈ 0.5: Unl, UnlP0, Unl+P1C, U2P1, U2P1C vs Q1P0, T1, Q1, "
+     "error vs time, against 16.4326 and a Q1P0 256² reference", "1 min",
+     60),
+    ("torsion", ["demos/torsion.py"],
+     "thesis Table 7.4: largest single rotation step, fewest steps per "
+     "turn; `--full` is the thesis' 16×16×80 (days)", "12 min", 720),
+    ("punch_3d", ["demos/punch_3d.py"],
+     "thesis 7.3.3: min u_z against an H1P0 reference, ν = 0.4 and "
+     "0.49999, inverted cells", "5 min", 300),
+    ("plastic_cylinder", ["demos/plastic_cylinder.py"],
+     "J2 plasticity: thick-walled cylinder, inner pressure against the "
+     "limit (2/√3)σ_y ln(b/a), Newton residuals", "12 s", 12),
+    ("necking", ["demos/necking.py"],
+     "thesis 7.3.5 / Fig. 7.24: cylindrical necking, force and neck radius "
+     "vs elongation, max ē_p of ten formulations against an H1P0 "
+     "overkill; VTU series", "10 min", 600),
+    ("taylor", ["demos/taylor.py"],
+     "thesis 7.3.7 / Table 7.6: Taylor anvil impact (explicit; `--newmark` "
+     "for the mixed ones): length, mushroom radius, max ē_p beside the "
+     "literature band; VTU series", "5.5 min; `--explicit` 22 min", 330),
+    ("cook_dynamic", ["demos/cook_dynamic.py"],
+     "thesis 7.2.4 / Fig. 7.12: dynamic Cook, four PG variants in TL and "
+     "UL", "2 min", 120),
+    ("torsion_dynamic", ["demos/torsion_dynamic.py"],
+     "thesis 7.3.6 / Table 7.5: dynamic torsion, max ē_p at 360°, failure "
+     "angle", "5 min", 300),
+    ("cook_mpi", ["demos/cook_mpi.py"],
+     "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
+     "Newton and KSP iterations, difference to the serial run (serial "
+     "here)", "20 s", 20),
+    ("assembly_scaling", ["benchmarks/assembly_scaling.py"],
+     "preprocessing / assembly / solve vs Q1 (2-D, up to 251k particles) "
+     "and H1 (`--dim 3`), both FE assembly paths", "minutes", 600),
+    ("newton_3d", ["benchmarks/newton_3d.py"],
+     "one 3-D Newton iteration, PG vs O1 / H1P0: material, assembly, "
+     "solve", "20 min", 1200),
+    ("scale_3d", ["benchmarks/scale_3d.py"],
+     "3-D linear elasticity from mesh to solution up to 100k particles, "
+     "peak memory", "15 min", 900),
+    ("accuracy_study", ["benchmarks/accuracy_study.py"],
+     "PG variants' errors relative to Q1/T1 on the same nodes", "minutes",
+     600),
+    ("bending_3d", ["benchmarks/bending_3d.py"],
+     "why VC PBG Unl is soft on 3-D tets", "1.5 min", 90),
+    ("solvers_3d", ["benchmarks/solvers_3d.py"],
+     "PARDISO, SuperLU and AMG on the same 3-D PG and O1 matrices: where "
+     "`\"auto\"` switches", "15 min", 900),
+    ("recipes_3d", ["benchmarks/recipes_3d.py"],
+     "the thesis recipe against kNN, O1, O2 (H1 on hex grids): Cook, "
+     "cantilever, plate with a hole, linear, against O2/H2 overkills",
+     "10 min", 600),
+    ("infsup_mixed", ["benchmarks/infsup_mixed.py"],
+     "inf-sup values of the mixed PG pairs beside Q1P0, MINI (thesis Fig. "
+     "7.15)", "1 min", 60),
+    ("mixed_newton", ["benchmarks/mixed_newton.py"],
+     "one Newton iteration of every mixed formulation vs PBG Unl and Q1P0 "
+     "/ H1P0", "5 min", 300),
+    ("plasticity_cost", ["benchmarks/plasticity_cost.py"],
+     "a plastic Newton iteration against the hyperelastic one: PG Unl, "
+     "U1SUnl, U1SIG, H1P0", "1 min", 60),
+    ("dynamics_cost", ["benchmarks/dynamics_cost.py"],
+     "explicit step per formulation vs O1/H1, Newmark step vs Newton "
+     "iteration", "3 min", 180),
+    ("mpi_scaling", ["benchmarks/mpi_scaling.py"],
+     "strong and weak scaling on 1 and 2 ranks against serial PG and H1 "
+     "(sparse direct)", "minutes", 600),
+]
+
+#: the README's test commands: key, pytest arguments, what they run
+TESTS = [
+    ("tests", [], "the fast set (the README's test command)"),
+    ("tests_study", ["-m", "study or slow"],
+     "the verification studies and slow tests"),
+    ("tests_demo", ["-m", "demo"], "the demos' `--quick` runs"),
+]
+
+
+def measure_script(command):
+    """``{"first": s, "cached": s or None}`` of ``python command`` at its
+    defaults, from an empty cache; raises ``RuntimeError`` with the
+    script's last output lines if it fails."""
+    with tempfile.TemporaryDirectory(prefix="skfem_pg_times_") as tmp:
+        cache, out = os.path.join(tmp, "cache"), os.path.join(tmp, "out")
+        env = dict(os.environ, SKFEM_PG_CACHE=cache, SKFEM_PG_OUT=out,
+                   MPLBACKEND="Agg")
+        times = {}
+        for run in ("first", "cached"):
+            t0 = time.perf_counter()
+            done = subprocess.run([sys.executable] + command, cwd=ROOT,
+                                  env=env, capture_output=True, text=True)
+            times[run] = time.perf_counter() - t0
+            if done.returncode:
+                raise RuntimeError("{} failed ({}):\n{}".format(
+                    " ".join(command), done.returncode,
+                    "\n".join((done.stdout + done.stderr)
+                              .splitlines()[-20:])))
+            if not (os.path.isdir(cache) and os.listdir(cache)):
+                times["cached"] = None
+                break
+    return times
+
+
+def measure_tests(args):
+    """``{"seconds": s, "passed": n}`` of ``python -m pytest -q args`` in
+    the source tree."""
+    t0 = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+        + args, cwd=ROOT, capture_output=True, text=True)
+    seconds = time.perf_counter() - t0
+    last = done.stdout.strip().splitlines()[-1] if done.stdout else ""
+    if done.returncode:
+        raise RuntimeError("pytest {} failed: {}".format(" ".join(args),
+                                                         last))
+    passed = re.search(r"(\d+) passed", last)
+    return {"seconds": seconds, "passed": int(passed.group(1))}
+
+
+def load():
+    """The stored measurements (``{}`` before the first)."""
+    if not os.path.exists(STORE):
+        return {}
+    with open(STORE) as fh:
+        return json.load(fh)
+
+
+def save(store):
+    """Write the measurements (atomically)."""
+    write_atomically(STORE, json.dumps(store, indent=1, sort_keys=True)
+                     + "\n")
+
+
+def seconds(s):
+    """``8 s``, ``1.5 min``, ``18 min``."""
+    if s < 90:
+        return "{:.0f} s".format(s)
+    return "{:.{}f} min".format(s / 60, 1 if s < 600 else 0)
+
+
+def time_cell(entry, hand):
+    """The time column of a script's row: measured, or the hand value."""
+    if entry is None:
+        return "{} (by hand)".format(hand)
+    if entry["cached"] is None:
+        text = seconds(entry["first"])
+    else:
+        text = "{} first run, {} cached".format(seconds(entry["first"]),
+                                                seconds(entry["cached"]))
+    return "{} ({})".format(text, entry["date"])
+
+
+def render_table(store):
+    """The demo table of ``benchmarks/README.md``."""
+    rows = [("`{}`".format(" ".join(cmd)), shows,
+             time_cell(store.get(key), hand))
+            for key, cmd, shows, hand, _ in SCRIPTS]
+    return ("Times on 2 cores at the default settings: the first run with an "
+            "empty cache, and the cached run where the script caches "
+            "something (its overkill references), written by "
+            "`benchmarks/run_times.py` with the date measured; `(by hand)` "
+            "marks times measured by hand when the script's issue closed, "
+            "not yet re-measured by it.  Each script's docstring has its "
+            "options; `--quick` runs a demo in seconds.\n\n"
+            + markdown_table(["script", "shows", "time"], rows)
+            .replace("| ---: | ---: |", "| --- | --- |", 1))
+
+
+def render_readme(store):
+    """The times paragraph of ``README.md`` and ``docs/getting_started.md``
+    (``None`` until the main job and the test commands are measured)."""
+    main = store.get("cook_neohooke")
+    tests = [store.get(key) for key, _, _ in TESTS]
+    if main is None or main["cached"] is None or None in tests:
+        return None
+    fast, study, demo = tests
+    return (
+        "Measured by `benchmarks/run_times.py` on 2 cores ({}): the main job "
+        "takes {} the first time (it computes its overkill then) and {} "
+        "with the cached one; the test command runs {} tests in {}; "
+        "`-m \"study or slow\"` {} in {}; `-m demo` {} in {}."
+        .format(main["date"], seconds(main["first"]),
+                seconds(main["cached"]), fast["passed"],
+                seconds(fast["seconds"]), study["passed"],
+                seconds(study["seconds"]), demo["passed"],
+                seconds(demo["seconds"])))
+
+
+def render(store):
+    """Rewrite the three pages' sections from ``store``."""
+    update_results(PAGES["benchmarks"], "run_times", render_table(store))
+    text = render_readme(store)
+    if text is not None:
+        for page in ("readme", "getting_started"):
+            update_results(PAGES[page], "readme_times", text)
+
+
+def main():
+    ap = demo_parser(__doc__, quick=False)
+    keys = [k for k, *_ in SCRIPTS] + [k for k, _, _ in TESTS]
+    ap.add_argument("--only", nargs="+", choices=keys, metavar="KEY",
+                    help="measure these scripts (their file names without "
+                    "'.py') and test commands ({})".format(
+                        ", ".join(k for k, _, _ in TESTS)))
+    ap.add_argument("--below", type=float, help="measure every script "
+                    "whose hand-measured time is below this many seconds, "
+                    "and the test commands")
+    ap.add_argument("--render", action="store_true",
+                    help="only re-render the pages from the stored "
+                    "measurements")
+    args = ap.parse_args()
+    if args.render:
+        render(load())
+        return
+    if args.only:
+        chosen = args.only
+    elif args.below is not None:
+        chosen = [k for k, _, _, _, s in SCRIPTS if s < args.below] + \
+            [k for k, _, _ in TESTS]
+    else:
+        ap.error("say what to measure: --only KEY ..., --below SECONDS or "
+                 "--render")
+    commands = {k: c for k, c, *_ in SCRIPTS}
+    tests = {k: a for k, a, _ in TESTS}
+    stamp = {"date": datetime.date.today().isoformat(),
+             "threads": threads.describe()}
+    for key in chosen:
+        print("measuring", key, flush=True)
+        store = load()
+        if key in tests:
+            store[key] = dict(measure_tests(tests[key]), **stamp)
+        else:
+            store[key] = dict(measure_script(commands[key]), **stamp)
+        print("  ", store[key], flush=True)
+        save(store)
+        render(store)
+
+
+if __name__ == "__main__":
+    main()
