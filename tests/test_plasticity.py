@@ -62,7 +62,7 @@ def test_return_map_tangent_is_derivative_of_stress(d, state):
         assert r.plastic.all()
     if state == "saturated":  # sigma_y within 1 % of its saturation line
         a = r.history["alpha"]
-        assert np.all(np.exp(-m.delta * a) < 0.01)
+        assert np.all(np.exp(-m.hardening.delta * a) < 0.01)
     A = r.tangent()
     Afd = fd_tangent(m, F, h)
     assert np.abs(A - Afd).max() <= 1e-6 * np.abs(A).max()
@@ -291,8 +291,7 @@ def test_every_mixed_formulation_carries_plasticity(name, incompressible):
     nu = 0.5): plastic strain and force equal the single-point law along
     the same load steps."""
     m = STEEL if not incompressible else J2Plasticity(
-        STEEL.mu, np.inf, STEEL.sigma_y0, H=STEEL.H,
-        sigma_yinf=STEEL.sigma_yinf, delta=STEEL.delta)
+        STEEL.mu, np.inf, hardening=STEEL.hardening)
     mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 6)] * 2)
     sc = Scene("plane strain tension", mesh.with_defaults(), m, steps=4,
                prescribed={"left": {0: 0.0}, "bottom": {1: 0.0},

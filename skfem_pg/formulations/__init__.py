@@ -29,6 +29,9 @@ What a driver asks of a model is :class:`~.protocol.Model`
                        variables at a model's integration points,
                        committed per converged step
 ``tangents``           finite-difference tangent of family forces
+``bond_based``         :class:`BondBased`: bond-based peridynamics with
+                       critical-stretch breaking (PMB), the classical
+                       comparator on the same particles and drivers
 =====================  ====================================================
 """
 from .linear import linear_elasticity
@@ -43,10 +46,12 @@ from .protocol import Model
 from .tangents import fd_tangent
 from .history import History
 from .updated_lagrange import UpdatedLagrange
+from .bond_based import BondBased, segment_cut
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
            "MasterIncompressible",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
-           "History", "UpdatedLagrange", "Model"]
+           "History", "UpdatedLagrange", "Model", "BondBased",
+           "segment_cut"]

@@ -156,6 +156,22 @@ class Hyperelastic:
         (``basis``; the current one in the updated Lagrangian frame)."""
         return self.basis
 
+    def failed(self):
+        """Where the committed damage of a damage law
+        (:mod:`~skfem_pg.materials.damage`) has failed the points
+        (:attr:`point_basis`' integration points), else ``None``."""
+        return None if self.history is None else self.history.failed()
+
+    def fracture_energy(self):
+        """The elastic energy the failed points released when they failed
+        (:mod:`~skfem_pg.materials.damage`), integrated; ``None`` without
+        a damage law.  Part of the internal work an explicit run records
+        as dissipation."""
+        r = None if self.history is None else self.history.released()
+        if r is None:
+            return None
+        return float(Elements(self.point_basis).sum(r).sum())
+
     def plastic_strain(self):
         """The committed accumulated plastic strain :math:`\\bar e_p`
         (the hardening variable) per element — its weighted mean over the

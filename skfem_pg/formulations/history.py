@@ -117,3 +117,23 @@ class History:
         if self.committed is None:
             return None
         return self.committed["alpha"]
+
+    def damage(self):
+        """The committed damage indicator at the points (``None`` without
+        a damage law, or before the first evaluation)."""
+        if self.committed is None:
+            return None
+        return self.committed.get("damage")
+
+    def failed(self):
+        """Where the committed damage has reached the law's critical value
+        (``None`` as for :meth:`damage`)."""
+        D = self.damage()
+        return None if D is None else D >= self.material.damage.Dc
+
+    def released(self):
+        """The committed energy density each point released when it
+        failed (``None`` as for :meth:`damage`)."""
+        if self.committed is None:
+            return None
+        return self.committed.get("released")

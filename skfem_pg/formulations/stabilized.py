@@ -205,12 +205,17 @@ class _MasterModel(Hyperelastic):
 
     def frozen(self):
         r"""``(mu~, K~, Cp_inv, F)`` of the committed master state: the
-        stabilization moduli (6.20) per family, the master's plastic metric
-        and deformation gradient."""
+        stabilization moduli (6.20) per family (zero where the master has
+        failed, :mod:`~skfem_pg.materials.damage`), the master's plastic
+        metric and deformation gradient."""
         key, F, Cp, alpha = self._committed()
         if self._frozen[0] is not key:
             vm = FrozenPlasticity(self.mu0, self.K0, Cp).von_mises(F)
             mu, K = stabilized_moduli(self.mu0, self.K0, vm, alpha)
+            failed = self.failed()
+            if failed is not None and failed.any():
+                # a failed master carries no stabilization either
+                mu, K = np.where(failed, 0.0, mu), np.where(failed, 0.0, K)
             self._frozen = (key, (mu, K, Cp, F))
         return self._frozen[1]
 
@@ -239,6 +244,12 @@ class _MasterModel(Hyperelastic):
         if a is None:
             a = np.zeros(len(self._master_flat))
         return np.array(a), float(a.max(initial=0.0))
+
+    def fracture_energy(self):
+        """The energy the failed masters released (:math:`\\sum_k V^k`
+        times their density), ``None`` without a damage law."""
+        r = None if self.history is None else self.history.released()
+        return None if r is None else self._master_energy(r)
 
     def _master_force(self, P1):
         r""":math:`\sum_k V^k P^k : \delta F^{kk}` (the U1 weights sum to

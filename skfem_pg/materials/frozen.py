@@ -22,7 +22,8 @@ and the tangent is that of :class:`~.hyperelastic.NeoHookeIsoVol` with
 enters the products and its out-of-plane component adds to :math:`c`.
 
 ``mu`` and ``K`` may vary per point (the modified :math:`\tilde E,
-\tilde\nu` of (6.20) differ per family).
+\tilde\nu` of (6.20) differ per family) and vanish at some (a failed
+point's stabilization, :mod:`~skfem_pg.materials.damage`).
 """
 import numpy as np
 
@@ -37,10 +38,10 @@ class FrozenPlasticity(Material):
 
     def __init__(self, mu, K, Cp_inv):
         self.mu, self.K = np.asarray(mu, float), np.asarray(K, float)
-        if np.any(self.mu <= 0) or np.any(self.K < 0) or \
-                not np.all(np.isfinite(self.K)):
-            raise ValueError("FrozenPlasticity needs mu > 0 and a finite "
-                             "K >= 0")
+        if np.any(self.mu < 0) or np.any(self.K < 0) or \
+                not np.all(np.isfinite(self.K)) or not np.any(self.mu > 0):
+            raise ValueError("FrozenPlasticity needs mu >= 0 (positive "
+                             "somewhere) and a finite K >= 0")
         self.Cp_inv = np.asarray(Cp_inv, float)
         if self.Cp_inv.shape[:2] != (3, 3):
             raise ValueError("Cp_inv must have shape (3, 3, ...), got {}"

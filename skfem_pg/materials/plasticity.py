@@ -50,6 +50,8 @@ out-of-plane component of :math:`C_p^{-1}` evolves with the others.
 import numpy as np
 
 from .constants import check_moduli
+from .damage import triaxiality
+from .hardening import LinearSaturation
 from .hyperelastic import Material, NeoHookeIsoVol, inverse_and_det
 
 #: local Newton: tolerance on the scaled residual and iteration limit
@@ -81,8 +83,10 @@ class ReturnMapError(RuntimeError):
 
 class J2Plasticity(Material):
     r"""Finite J2 elasto-plasticity with neo-Hooke elasticity, von Mises
-    yield and linear plus saturation hardening (module docstring); the
-    parameters carry the thesis' symbols, (2.46)–(2.49).
+    yield and isotropic hardening (module docstring); the parameters carry
+    the thesis' symbols, (2.46)–(2.49).  Optionally with ductile damage
+    (thesis 8.1): a damage indicator at every point, failure at its
+    critical value.
 
     A stateful material: :meth:`initial_history` gives the history at a
     set of points and :meth:`update` the response to ``F`` from a
@@ -95,51 +99,75 @@ class J2Plasticity(Material):
         Shear and bulk modulus of the elastic part (``K = np.inf``:
         incompressible, for the formulations that carry the pressure).
     sigma_y0
-        Initial yield stress.
+        Initial yield stress of the thesis' hardening law (2.49).
     H
         Linear hardening modulus.
     sigma_yinf
         Saturation yield stress (default ``sigma_y0``: no saturation).
     delta
         Saturation exponent.
+    hardening
+        Instead of ``sigma_y0, H, sigma_yinf, delta``: a hardening law of
+        :mod:`~skfem_pg.materials.hardening`, e.g.
+        ``JohnsonCookHardening(A, B, n)``.
+    damage
+        A damage law of :mod:`~skfem_pg.materials.damage`
+        (``JohnsonCookDamage(D1, D2, D3, Dc)``), or ``None``.  The history
+        then carries ``damage``; until a point fails its stress is the
+        plain law's.  A *failed* point (``damage >= Dc``, from the step
+        in which it gets there) carries no deviatoric stress and no
+        tension: its Kirchhoff stress is the volumetric part
+        :math:`\frac K2(J^2 - 1) I` while :math:`J < 1` (crack faces
+        pressed together transmit pressure) and zero while
+        :math:`J \ge 1`; its plastic strain and :math:`C_p^{-1}` stay
+        where they were.
+
+    Examples
+    --------
+    The thesis' steel of 8.1 (Broumand & Khoei 2015), in N, mm, s:
+
+    >>> from skfem_pg.materials import (JohnsonCookHardening,
+    ...                                 JohnsonCookDamage)
+    >>> steel = J2Plasticity.from_young(
+    ...     200e3, 0.29, hardening=JohnsonCookHardening(792.0, 510.0, 0.26),
+    ...     damage=JohnsonCookDamage(0.05, 3.44, -2.12, 0.3))
     """
 
     stateful = True
 
-    def __init__(self, mu, K, sigma_y0, H=0.0, sigma_yinf=None, delta=0.0):
+    def __init__(self, mu, K, sigma_y0=None, H=0.0, sigma_yinf=None,
+                 delta=0.0, hardening=None, damage=None):
         if isinstance(K, (int, float, np.number)) and np.isposinf(K):
             # incompressible: the documented use of inf
             self.mu, self.K = check_moduli(mu=mu)[0], np.inf
         else:  # nan, -inf and K <= 0 are refused by name
             self.mu, self.K = check_moduli(mu=mu, K=K)
-        for name, value in (("sigma_y0", sigma_y0), ("H", H),
-                            ("sigma_yinf", sigma_yinf), ("delta", delta)):
-            if value is None:
-                continue
-            try:
-                ok = np.isfinite(float(value))
-            except (TypeError, ValueError):
-                ok = False
-            if not ok:
-                raise ValueError("J2Plasticity: {} must be a finite number, "
-                                 "got {!r}".format(name, value))
-        self.sigma_y0 = float(sigma_y0)
-        self.H = float(H)
-        self.sigma_yinf = float(sigma_y0 if sigma_yinf is None
-                                else sigma_yinf)
-        self.delta = float(delta)
-        if not self.sigma_y0 > 0:
-            raise ValueError("sigma_y0 must be positive, got {}".format(
-                sigma_y0))
-        if self.H < 0 or self.delta < 0:
-            raise ValueError("H and delta must be >= 0 (softening is not "
-                             "built), got H = {}, delta = {}".format(H, delta))
-        if self.sigma_yinf < self.sigma_y0:
-            raise ValueError("sigma_yinf ({}) below sigma_y0 ({}) would "
-                             "soften".format(sigma_yinf, sigma_y0))
+        if hardening is None:
+            if sigma_y0 is None:
+                raise TypeError("J2Plasticity needs sigma_y0 (the thesis' "
+                                "hardening law (2.49)) or hardening=")
+            hardening = LinearSaturation(sigma_y0, H, sigma_yinf, delta)
+        elif sigma_y0 is not None or H or sigma_yinf is not None or delta:
+            raise TypeError("J2Plasticity: give either sigma_y0, H, "
+                            "sigma_yinf, delta or hardening={!r}, not both"
+                            .format(hardening))
+        for name, law, needs in (("hardening", hardening,
+                                  ("stress", "slope", "initial")),
+                                 ("damage", damage,
+                                  ("increment", "Dc"))):
+            if law is not None and not all(hasattr(law, a) for a in needs):
+                raise TypeError("J2Plasticity: {}={!r} is not a {} law "
+                                "(it needs {})".format(name, law, name,
+                                                       ", ".join(needs)))
+        self.hardening, self.damage = hardening, damage
+
+    def __repr__(self):
+        return "J2Plasticity(mu={:g}, K={:g}, hardening={!r}{})".format(
+            self.mu, self.K, self.hardening, "" if self.damage is None
+            else ", damage={!r}".format(self.damage))
 
     @classmethod
-    def from_young(cls, E, nu, sigma_y0, **kw):
+    def from_young(cls, E, nu, sigma_y0=None, **kw):
         """From Young's modulus and Poisson's ratio."""
         E, nu = check_moduli(E=E, nu=nu)
         mu = E / (2 * (1 + nu))
@@ -148,9 +176,17 @@ class J2Plasticity(Material):
     def isochoric(self):
         """The same law without the volumetric part (``K = 0``), for the
         mixed formulations that add it per element or particle; the
-        return map does not depend on ``K``."""
-        m = J2Plasticity(self.mu, 1.0, self.sigma_y0, self.H,
-                         self.sigma_yinf, self.delta)
+        return map does not depend on ``K``.  Not with damage: a failed
+        point's no-tension rule acts on the pressure, which those
+        formulations carry."""
+        if self.damage is not None:
+            raise NotImplementedError(
+                "{!r}: damage needs the pressure at the point (a failed "
+                "point carries no tension); the mixed formulations that add "
+                "the pressure per element or particle (UnlP0, IUnlP0, "
+                "Q1P0/H1P0) do not take it yet: use Unl, U1SUnl, U1SIG or "
+                "FE Q1/H1/T1/O1".format(self))
+        m = J2Plasticity(self.mu, 1.0, hardening=self.hardening)
         m.K = 0.0
         return m
 
@@ -161,24 +197,32 @@ class J2Plasticity(Material):
         return m
 
     # -- hardening -----------------------------------------------------
+    @property
+    def sigma_y0(self):
+        """The initial yield stress, :math:`\\sigma_y(0)`."""
+        return self.hardening.initial
+
     def yield_stress(self, alpha):
-        """:math:`\\sigma_y(\\alpha)` (2.49)."""
-        a = np.asarray(alpha, dtype=float)
-        return (self.sigma_y0 + self.H * a + (self.sigma_yinf - self.sigma_y0)
-                * (1.0 - np.exp(-self.delta * a)))
+        r""":math:`\sigma_y(\alpha)` of the hardening law."""
+        return self.hardening.stress(alpha)
 
     def _hardening_slope(self, a):
-        return self.H + (self.sigma_yinf - self.sigma_y0) * self.delta * \
-            np.exp(-self.delta * a)
+        return self.hardening.slope(a)
 
     # -- history -------------------------------------------------------
     def initial_history(self, point_shape):
         """The virgin state at points of shape ``point_shape``:
-        ``Cp_inv`` ``(3, 3, *point_shape)`` the identity, ``alpha`` zero."""
+        ``Cp_inv`` ``(3, 3, *point_shape)`` the identity, ``alpha`` (and
+        with a damage law ``damage`` and ``released``, the energy density
+        a point released when it failed) zero."""
         shape = tuple(point_shape)
         Cp = np.broadcast_to(np.eye(3).reshape((3, 3) + (1,) * len(shape)),
                              (3, 3) + shape).copy()
-        return {"Cp_inv": Cp, "alpha": np.zeros(shape)}
+        h = {"Cp_inv": Cp, "alpha": np.zeros(shape)}
+        if self.damage is not None:
+            h["damage"] = np.zeros(shape)
+            h["released"] = np.zeros(shape)
+        return h
 
     # -- the stress update ---------------------------------------------
     def update(self, F, history):
@@ -375,6 +419,9 @@ class Response:
             tau_full[:, i, i] -= m.mu * tr / 3.0
         vm = np.sqrt(1.5 * (tau_full * tau_full).sum(axis=(1, 2)))
         plastic = vm - m.yield_stress(alpha_n) > 0
+        if m.damage is not None:
+            damage = history["damage"].reshape(n).copy()
+            plastic &= damage < m.damage.Dc  # a failed point does not flow
         self._trbb = tr
         alpha = alpha_n.copy()
         p = np.flatnonzero(plastic)
@@ -401,6 +448,30 @@ class Response:
             Cp_new[p] = 0.5 * (Cp_p + np.swapaxes(Cp_p, 1, 2))
         self.plastic = plastic.reshape(self.point_shape)
         vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
+        failed = np.zeros(n, dtype=bool)
+        if m.damage is not None:
+            if p.size:
+                damage[p] += m.damage.increment(alpha[p] - alpha_n[p],
+                                                triaxiality(tau_full[p],
+                                                            vol[p]))
+            failed = damage >= m.damage.Dc
+            # the energy density a point failing now releases: what it
+            # would store intact, less what it keeps (pressure in
+            # compression)
+            released = history["released"].reshape(n).copy()
+            now = failed & (history["damage"].reshape(n) < m.damage.Dc)
+            if now.any():
+                Jn = J[now]
+                released[now] += 0.5 * m.mu * (self._trbb[now] - 3) + \
+                    np.where(Jn >= 1, 0.25 * m.K * (Jn ** 2 - 1
+                                                    - 2 * np.log(Jn)), 0.0)
+            # a failed point: no deviatoric stress, pressure only in
+            # compression (module docstring of skfem_pg.materials.damage)
+            tau_full[failed] = 0.0
+            self._trbb[failed] = 3.0
+            vol = np.where(failed & (J >= 1), 0.0, vol)
+        self._failed = failed
+        self.failed = failed.reshape(self.point_shape)
         for i in range(3):
             tau_full[:, i, i] += vol
         P3 = tau_full @ np.swapaxes(Finv, 1, 2)
@@ -412,6 +483,9 @@ class Response:
             "Cp_inv": np.moveaxis(Cp_new, 0, 2).reshape(
                 (3, 3) + self.point_shape),
             "alpha": alpha.reshape(self.point_shape)}
+        if m.damage is not None:
+            self.history["damage"] = damage.reshape(self.point_shape)
+            self.history["released"] = released.reshape(self.point_shape)
         self._A = None
         self._spectral = None
 
@@ -438,7 +512,8 @@ class Response:
         W = 0.5 * m.mu * (self._trbb - 3)
         if m.K > 0:
             J = self.J
-            W = W + 0.25 * m.K * (J ** 2 - 1 - 2 * np.log(J))
+            W = W + np.where(self._failed & (J >= 1), 0.0, 0.25 * m.K * (
+                J ** 2 - 1 - 2 * np.log(J)))
         return W.reshape(self.point_shape)
 
     def tangent(self):
@@ -483,8 +558,13 @@ class Response:
         A = np.moveaxis(A, 4, 2)  # iJkL
         P3 = self._P3
         A -= P3[:, :, None, None, :] * Finv[:, None, :, :, None]
+        failed = self._failed
+        if failed.any():  # P = p F^-T: only the two terms below remain
+            A[failed] = 0.0
+            A[failed] -= (P3[failed, :, None, None, :]
+                          * Finv[failed, None, :, :, None])
         if m.K > 0:
-            J2 = self.J ** 2
+            J2 = np.where(failed & (self.J >= 1), 0.0, self.J ** 2)
             FinvT = np.swapaxes(Finv, 1, 2)
             # d[(K/2)(J^2 - 1) F^-T]: K J^2 F^-T x F^-T; the -F^-1 F^-1
             # part is in -P_iL Finv_Jk already

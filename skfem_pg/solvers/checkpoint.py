@@ -140,11 +140,12 @@ def load(path, model, state=False):
         raise ValueError("checkpoint {} holds a history, the model's "
                          "material has none".format(path))
     if h is not None:
-        if h.committed is not None and saved and \
-                saved["alpha"].shape != h.committed["alpha"].shape:
-            raise ValueError("checkpoint {}: history at {} points, the model "
-                             "has {}".format(path, saved["alpha"].shape,
-                                             h.committed["alpha"].shape))
+        for k in set(saved) & set(h.committed or ()):
+            if saved[k].shape != np.shape(h.committed[k]):
+                raise ValueError(
+                    "checkpoint {}: history {!r} of shape {}, the model's "
+                    "has {}".format(path, k, saved[k].shape,
+                                    np.shape(h.committed[k])))
         h.restore(saved or None)
     if not state:
         return x, lam

@@ -325,6 +325,12 @@ class Recorder:
         t1 = time.perf_counter()
         rec = self.energy.record(t, v, self.free & ~held,
                                  stored_energy(self.model, state))
+        fracture = getattr(self.model, "fracture_energy", None)
+        fracture = None if fracture is None else fracture()
+        if fracture is not None:
+            # part of the dissipation: what failed points or broken bonds
+            # had stored when they failed
+            rec["fracture"] = fracture
         rec.update(data)
         self.hist.append(rec)
         self.progress(t, data["dt"], data["steps"], rec, force=final)

@@ -1,0 +1,89 @@
+r"""Ductile damage laws for the J2 material: an uncoupled damage indicator
+:math:`D` at every integration point that accumulates with the plastic
+strain and fails the point at a critical value (thesis 8.1).
+
+:class:`JohnsonCookDamage` is Johnson and Cook's (1985) law without rate
+and temperature terms, as the thesis uses it:
+
+.. math:: D = \sum \frac{\Delta\bar e_p}{\varepsilon_f(\sigma^*)}, \qquad
+          \varepsilon_f = D_1 + D_2 \exp(D_3\,\sigma^*), \qquad
+          \sigma^* = \frac{\operatorname{tr}\sigma / 3}{\sigma_{vM}},
+
+summed over the steps with :math:`\sigma^*` the stress triaxiality of the
+step's stress (Cauchy or Kirchhoff: :math:`J` cancels); the point fails
+when :math:`D \ge D_c`.  Where :math:`\varepsilon_f \le 0` (a negative
+:math:`D_1` at high triaxiality) any plastic strain fails the point.
+Until failure the stress does not depend on :math:`D` (the damage-free
+limit is the plain J2 law exactly); what a failed point carries is
+:class:`~skfem_pg.materials.J2Plasticity`'s (no deviatoric stress, no
+tension).
+"""
+import numpy as np
+
+
+class JohnsonCookDamage:
+    r"""Johnson–Cook ductile damage (module docstring).
+
+    Parameters
+    ----------
+    D1, D2, D3
+        The failure strain's constants, :math:`\varepsilon_f = D_1 + D_2
+        e^{D_3\sigma^*}` (``D2 >= 0``).
+    Dc
+        Critical damage, in (0, 1] (thesis 8.1: 0.3).
+
+    Examples
+    --------
+    Broumand & Khoei's steel (thesis 8.1): the failure strain in pure
+    shear and in uniaxial tension.
+
+    >>> law = JohnsonCookDamage(0.05, 3.44, -2.12, 0.3)
+    >>> law.failure_strain([0.0, 1 / 3])  # doctest: +ELLIPSIS
+    array([3.49      , 1.7469...])
+    """
+
+    def __init__(self, D1, D2, D3, Dc):
+        values = []
+        for name, value in (("D1", D1), ("D2", D2), ("D3", D3), ("Dc", Dc)):
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                v = np.nan
+            if not np.isfinite(v):
+                raise ValueError("JohnsonCookDamage: {} must be a finite "
+                                 "number, got {!r}".format(name, value))
+            values.append(v)
+        self.D1, self.D2, self.D3, self.Dc = values
+        if self.D2 < 0:
+            raise ValueError("JohnsonCookDamage: D2 must be >= 0, got {}"
+                             .format(D2))
+        if not 0 < self.Dc <= 1:
+            raise ValueError("JohnsonCookDamage: the critical damage Dc must "
+                             "lie in (0, 1], got {}".format(Dc))
+
+    def __repr__(self):
+        return "JohnsonCookDamage(D1={:g}, D2={:g}, D3={:g}, Dc={:g})".format(
+            self.D1, self.D2, self.D3, self.Dc)
+
+    def failure_strain(self, triaxiality):
+        r""":math:`\varepsilon_f(\sigma^*) = D_1 + D_2 e^{D_3\sigma^*}`."""
+        t = np.asarray(triaxiality, dtype=float)
+        return self.D1 + self.D2 * np.exp(self.D3 * t)
+
+    def increment(self, dalpha, triaxiality):
+        r""":math:`\Delta D = \Delta\bar e_p / \varepsilon_f(\sigma^*)`
+        (infinite where :math:`\varepsilon_f \le 0` and
+        :math:`\Delta\bar e_p > 0`: the point fails)."""
+        ef = self.failure_strain(triaxiality)
+        da = np.asarray(dalpha, dtype=float)
+        with np.errstate(divide="ignore"):
+            return np.where(ef > 0, da / np.where(ef > 0, ef, 1.0),
+                            np.where(da > 0, np.inf, 0.0))
+
+
+def triaxiality(tau_dev, mean):
+    r""":math:`\sigma^* = p / \sigma_{vM}` of Kirchhoff (or Cauchy)
+    stresses given by their deviators ``tau_dev`` ``(n, 3, 3)`` and mean
+    stresses ``mean`` ``(n,)`` (0 where the deviator vanishes)."""
+    vm = np.sqrt(1.5 * (tau_dev * tau_dev).sum(axis=(1, 2)))
+    return np.where(vm > 0, mean / np.where(vm > 0, vm, 1.0), 0.0)
