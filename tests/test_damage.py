@@ -32,6 +32,19 @@ def walk(material, Fs):
     return out
 
 
+def fd_tangent(material, F, h, eps=1e-7):
+    """Central differences of the stress update from the history ``h``
+    at ``F`` ``(3, 3, 1)``."""
+    A = np.zeros((3, 3, 3, 3, 1))
+    for k in range(3):
+        for L in range(3):
+            dF = np.zeros_like(F)
+            dF[k, L] = eps
+            A[:, :, k, L] = (material.update(F + dF, h).P
+                             - material.update(F - dF, h).P) / (2 * eps)
+    return A
+
+
 def von_mises(P, F):
     """σ_vM of the Kirchhoff stress P F^T at one point."""
     tau = P[:, :, 0] @ F[:, :, 0].T
@@ -55,14 +68,7 @@ def test_johnson_cook_flow_stress_in_the_return_map():
     rng = np.random.default_rng(0)
     F = Fs[6] + 0.01 * rng.uniform(-1, 1, (3, 3, 1))
     A = steel.update(F, h).tangent()
-    eps, Afd = 1e-7, np.zeros_like(A)
-    for k in range(3):
-        for L in range(3):
-            dF = np.zeros_like(F)
-            dF[k, L] = eps
-            Afd[:, :, k, L] = (steel.update(F + dF, h).P
-                               - steel.update(F - dF, h).P) / (2 * eps)
-    assert np.abs(A - Afd).max() <= 1e-6 * np.abs(A).max()
+    assert np.abs(A - fd_tangent(steel, F, h)).max() <= 1e-6 * np.abs(A).max()
 
 
 def test_damage_at_fixed_triaxiality_is_the_closed_form():
@@ -167,14 +173,7 @@ def test_a_failed_point_carries_pressure_in_compression_only():
     assert np.abs(tau - steel.K / 2 * (Jn ** 2 - 1) * np.eye(3)).max() \
         <= 1e-9 * steel.K * (1 - Jn)
     A = r.tangent()
-    eps, Afd = 1e-7, np.zeros_like(A)
-    for k in range(3):
-        for L in range(3):
-            dF = np.zeros_like(F)
-            dF[k, L] = eps
-            Afd[:, :, k, L] = (steel.update(F + dF, h).P
-                               - steel.update(F - dF, h).P) / (2 * eps)
-    assert np.abs(A - Afd).max() <= 1e-6 * np.abs(A).max()
+    assert np.abs(A - fd_tangent(steel, F, h)).max() <= 1e-6 * np.abs(A).max()
     tension = steel.update(stretch(1.05, 1.01), h)
     assert np.all(tension.P == 0) and np.all(tension.tangent() == 0)
 

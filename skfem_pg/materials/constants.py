@@ -57,3 +57,20 @@ def lame(E, nu, plane_stress=False):
     if plane_stress:
         lam = 2 * lam * mu / (lam + 2 * mu)
     return lam, mu
+
+
+def check_finite(owner, **values):
+    """The ``values`` as floats, in the order given; a value that is not a
+    finite number raises ``ValueError`` naming it and ``owner`` (the law
+    whose parameter it is)."""
+    out = []
+    for name, value in values.items():
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            v = np.nan
+        if not np.isfinite(v):
+            raise ValueError("{}: {} must be a finite number, got {!r}"
+                             .format(owner, name, value))
+        out.append(v)
+    return out

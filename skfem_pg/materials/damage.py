@@ -20,6 +20,8 @@ tension).
 """
 import numpy as np
 
+from .constants import check_finite
+
 
 class JohnsonCookDamage:
     r"""Johnson–Cook ductile damage (module docstring).
@@ -43,17 +45,8 @@ class JohnsonCookDamage:
     """
 
     def __init__(self, D1, D2, D3, Dc):
-        values = []
-        for name, value in (("D1", D1), ("D2", D2), ("D3", D3), ("Dc", Dc)):
-            try:
-                v = float(value)
-            except (TypeError, ValueError):
-                v = np.nan
-            if not np.isfinite(v):
-                raise ValueError("JohnsonCookDamage: {} must be a finite "
-                                 "number, got {!r}".format(name, value))
-            values.append(v)
-        self.D1, self.D2, self.D3, self.Dc = values
+        self.D1, self.D2, self.D3, self.Dc = check_finite(
+            "JohnsonCookDamage", D1=D1, D2=D2, D3=D3, Dc=Dc)
         if self.D2 < 0:
             raise ValueError("JohnsonCookDamage: D2 must be >= 0, got {}"
                              .format(D2))

@@ -16,19 +16,7 @@ else, so a new law is a new class here.
 """
 import numpy as np
 
-
-def _finite(owner, **values):
-    out = []
-    for name, value in values.items():
-        try:
-            v = float(value)
-        except (TypeError, ValueError):
-            v = np.nan
-        if not np.isfinite(v):
-            raise ValueError("{}: {} must be a finite number, got {!r}"
-                             .format(owner, name, value))
-        out.append(v)
-    return out
+from .constants import check_finite
 
 
 class LinearSaturation:
@@ -48,7 +36,7 @@ class LinearSaturation:
     """
 
     def __init__(self, sigma_y0, H=0.0, sigma_yinf=None, delta=0.0):
-        self.sigma_y0, self.H, self.sigma_yinf, self.delta = _finite(
+        self.sigma_y0, self.H, self.sigma_yinf, self.delta = check_finite(
             "J2Plasticity", sigma_y0=sigma_y0, H=H,
             sigma_yinf=sigma_y0 if sigma_yinf is None else sigma_yinf,
             delta=delta)
@@ -118,7 +106,7 @@ class JohnsonCookHardening:
     alpha0 = 1e-300
 
     def __init__(self, A, B, n):
-        self.A, self.B, self.n = _finite("JohnsonCookHardening", A=A, B=B,
+        self.A, self.B, self.n = check_finite("JohnsonCookHardening", A=A, B=B,
                                          n=n)
         if not self.A > 0:
             raise ValueError("JohnsonCookHardening: A (the initial yield "
