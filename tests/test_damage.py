@@ -113,8 +113,8 @@ def test_damage_under_hardening_converges_to_the_integral():
     """With hardening the triaxiality falls as σ_y grows; the damage the
     steps sum (each with its end-of-step triaxiality) converges at first
     order to ∫ dē_p / ε_f(p / σ_y(ē_p))."""
-    steel = J2Plasticity.from_young(E, NU, hardening=JC, damage=JohnsonCookDamage(
-        0.05, 3.44, -2.12, 1.0))
+    steel = J2Plasticity.from_young(
+        E, NU, hardening=JC, damage=JohnsonCookDamage(0.05, 3.44, -2.12, 1.0))
     J, lam = 1.002, 1.1
     p = steel.K * (J ** 2 - 1) / 2
     errors = []
