@@ -99,6 +99,10 @@ SCRIPTS = [
     ("torsion_dynamic", ["demos/torsion_dynamic.py"],
      "thesis 7.3.6 / Table 7.5: dynamic torsion, max ē_p at 360°, failure "
      "angle", "5 min", 300),
+    ("two_hole_plate", ["demos/two_hole_plate.py"],
+     "thesis 8.1 / Fig. 8.1: ductile fracture of a plate with two holes, "
+     "Johnson–Cook damage on PG U1SIG beside FE Q1 erosion; crack "
+     "snapshots, bottom force and energies; VTU series", "3 min", 180),
     ("cook_mpi", ["demos/cook_mpi.py"],
      "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
      "Newton and KSP iterations, difference to the serial run (serial "

@@ -89,6 +89,9 @@ def step_writer(basis, **fields):
         mesh = basis.mesh
         m = to_meshio(mesh, encode_cell_data=False)
         d = mesh.dim()
+        if m.points.shape[1] == 2:  # VTU points are 3-D
+            m.points = np.column_stack([m.points,
+                                        np.zeros(m.points.shape[0])])
         points, cells = {}, {}
         for name, val in fields.items():
             val = np.asarray(val, dtype=float)

@@ -179,6 +179,13 @@ def _taylor(out):
     assert float(pg_[6]) <= 1e-3  # energy error
 
 
+def _two_hole_plate(out):
+    balances = [float(v) for v in re.findall(r"energy balance ([-+\d.e]+)",
+                                             out)]
+    assert len(balances) == 2 and max(abs(b) for b in balances) <= 1e-2
+    assert "first failure at t" in out  # the quick run already fails
+
+
 CHECKS = {
     "necking.py": (_necking, "necking.png"),
     "torsion.py": (_torsion, "torsion.png"),
@@ -200,6 +207,7 @@ CHECKS = {
     "cook_neohooke.py": (_cook_neohooke, "cook_neohooke.png"),
     "compression_3d.py": (_compression_3d, None),
     "cook_dynamic.py": (_cook_dynamic, "cook_dynamic.png"),
+    "two_hole_plate.py": (_two_hole_plate, "two_hole_plate.png"),
 }
 
 

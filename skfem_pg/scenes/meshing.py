@@ -459,7 +459,8 @@ def _meshes_dir():
 def geo_path(name):
     """Path of a ``.geo`` file shipped with the package (the repository's
     ``meshes/``, installed as ``skfem_pg.meshes``: cook.geo, cook3d.geo,
-    cube.geo, square.geo, beam3d.geo, plate_hole3d.geo)."""
+    cube.geo, square.geo, beam3d.geo, plate_hole3d.geo,
+    plate_two_holes.geo)."""
     here = os.path.normpath(_meshes_dir())
     fn = os.path.join(here, name)
     if not os.path.isfile(fn):
