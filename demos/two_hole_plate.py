@@ -58,6 +58,8 @@ def setup(mesh, method):
         basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
         return basis, Hyperelastic(basis, STEEL)
     basis = pg.FamilyBasis.from_name(mesh, method, dim=2)
+    # the plots and the VTU take a particle's value as its vertex's
+    assert np.array_equal(basis.particles.x, mesh.p)
     return basis, model_for(method.split()[-1], basis, STEEL)
 
 
@@ -82,6 +84,11 @@ def damage_per_node(model, basis, mesh):
 
 
 def run(mesh, method, t_end, snapshots, folder, outputs):
+    """Pull the plate with ``method`` until ``t_end``: at every output
+    (``outputs`` steps apart; ``None``: the driver's about 20) the bottom
+    force, the stored and released energies, a VTU step in ``folder``
+    and, at the first output after each time of ``snapshots``, the
+    displacement and damage for the figure."""
     basis, model = setup(mesh, method)
     X = basis.doflocs
     vertical = np.arange(basis.N) % 2 == 1
@@ -119,6 +126,7 @@ def run(mesh, method, t_end, snapshots, folder, outputs):
 
 
 def report(r):
+    """Print what :func:`run` measured for one model."""
     c = r["curve"]
     peak_f, peak_w = np.argmax(c[:, 1]), np.argmax(c[:, 2])
     last = r["trajectory"].history[-1]
@@ -143,6 +151,8 @@ def report(r):
 
 
 def plot(results, mesh, fn):
+    """Damage on the deformed plate at the snapshots and the force and
+    energy curves, one row per model, to ``fn``."""
     rows = len(results)
     ncols = max(len(r["shots"]) for r in results) + 1
     fig, axes = new_figure(ncols, figsize=(3.2 * ncols, 4.2 * rows))
