@@ -186,6 +186,12 @@ def _two_hole_plate(out):
     assert "first failure at t" in out  # the quick run already fails
 
 
+def _kalthoff_winkler(out):
+    (row,) = _rows(out, "upper")  # upper, lower angle, experiment
+    assert abs(row[0] - row[1]) <= 1.0  # the plate is symmetric
+    assert 60.0 <= row[0] <= 80.0  # the experiment: about 70 degrees
+
+
 CHECKS = {
     "necking.py": (_necking, "necking.png"),
     "torsion.py": (_torsion, "torsion.png"),
@@ -208,6 +214,7 @@ CHECKS = {
     "compression_3d.py": (_compression_3d, None),
     "cook_dynamic.py": (_cook_dynamic, "cook_dynamic.png"),
     "two_hole_plate.py": (_two_hole_plate, "two_hole_plate.png"),
+    "kalthoff_winkler.py": (_kalthoff_winkler, "kalthoff_winkler.png"),
 }
 
 
