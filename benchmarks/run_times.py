@@ -101,11 +101,13 @@ SCRIPTS = [
      "angle", "5 min", 300),
     ("two_hole_plate", ["demos/two_hole_plate.py"],
      "thesis 8.1 / Fig. 8.1: ductile fracture of a plate with two holes, "
-     "Johnson–Cook damage on PG U1SIG beside FE Q1 erosion; crack "
-     "snapshots, bottom force and energies; VTU series", "3 min", 180),
+     "Johnson–Cook damage on PG U1SIG and Unl (connectivity kept, and "
+     "crack-aware families) beside FE Q1 erosion; crack snapshots, bottom "
+     "force and energies; VTU series", "15 min", 900),
     ("kalthoff_winkler", ["demos/kalthoff_winkler.py"],
-     "Kalthoff–Winkler impact with the bond-based comparator (PMB): the "
-     "crack angle against the experiment's 70 degrees", "8 s", 8),
+     "Kalthoff–Winkler impact with the bond-based comparator (PMB) and PG "
+     "Unl with a brittle criterion (connectivity kept, crack-aware): the "
+     "crack angles against the experiment's 70 degrees", "2 min", 120),
     ("cook_mpi", ["demos/cook_mpi.py"],
      "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
      "Newton and KSP iterations, difference to the serial run (serial "

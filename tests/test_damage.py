@@ -257,3 +257,27 @@ def test_formulations_carry_damage_and_the_mixed_ones_refuse_it():
     fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
     with pytest.raises(NotImplementedError, match="Q1P0"):
         model_for("Q1P0", fe, steel)
+
+
+def test_the_critical_strain_criterion_fails_at_its_strain():
+    """CriticalStrainDamage on an elastic J2 point (a yield stress the
+    path does not reach): a uniaxial stretch just below exp(e_c) leaves
+    the point intact, just above fails it, for good; compression does
+    not; the crack-band strain sqrt(2 G0 / (E h))."""
+    from skfem_pg.materials import CriticalStrainDamage
+    law = CriticalStrainDamage(0.01)
+    m = J2Plasticity.from_young(E, NU, 1e9, damage=law)
+    F = lambda lam: np.diag([lam, 1.0, 1.0])[:, :, None]  # noqa: E731
+    lam_c = np.exp(0.01)
+    below = walk(m, [F(1 + 0.5 * (lam_c - 1)), F(lam_c * (1 - 1e-9))])
+    assert not below[-1].failed.any()
+    assert below[-1].history["damage"][0] == pytest.approx(1.0, abs=1e-7)
+    after = walk(m, [F(lam_c * (1 + 1e-9)), F(1.0)])
+    assert after[0].failed.all() and after[1].failed.all()
+    assert np.abs(after[1].P).max() == 0.0  # failed, unloaded
+    assert not walk(m, [F(0.97)])[0].failed.any()
+    assert CriticalStrainDamage.from_fracture_energy(
+        22.17, 190e3, 1.0).critical_strain == pytest.approx(
+            np.sqrt(2 * 22.17 / 190e3))
+    with pytest.raises(ValueError, match="positive"):
+        CriticalStrainDamage(0.0)

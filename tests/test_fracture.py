@@ -39,7 +39,7 @@ def strip(n, notch_cells):
     return mesh, y_notch
 
 
-def pull(model, basis, t_end, speed, grip):
+def pull(model, basis, t_end, speed, grip, kw_out=20, **kw):
     """Clamped grips: the bottom layer (``grip`` deep) held, the top
     layer pulled straight up at ``speed`` after a smooth start over a
     tenth of the run; returns the
@@ -57,20 +57,20 @@ def pull(model, basis, t_end, speed, grip):
             (t - ramp / np.pi * np.sin(np.pi * t / ramp)) / 2 if t < ramp
             else t - ramp / 2)
         return u
-    first = []
+    first = [None]  # (a resumed run may start after the first failure)
     points = basis.particles.x if hasattr(basis, "particles") else \
         basis.mesh.p[:, basis.mesh.t].mean(axis=1)
     before = particle_damage(model, basis)
 
     def watch(t, x, v, record):
         new = particle_damage(model, basis) > before + 0.05
-        if new.any() and not first:
+        if new.any() and len(first) == 1:
             first.append(points[:, new])
     tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), t_end,
                                D=np.concatenate([bottom, top]), u_D=u_D,
-                               callback=watch, output_every=20,
-                               verbose=False)
-    return tr, first[0]
+                               callback=watch, output_every=kw_out,
+                               verbose=False, **kw)
+    return tr, first[-1]
 
 
 def particle_damage(model, basis):
@@ -83,7 +83,13 @@ def particle_damage(model, basis):
         return np.zeros(basis.particles.n if hasattr(basis, "particles")
                         else basis.mesh.t.shape[1])
     E = Elements(model.point_basis)
-    return E.sum(failed.astype(float)) / E.volumes
+    share = E.sum(failed.astype(float)) / E.volumes
+    if not hasattr(basis, "particles"):
+        return share
+    # per particle (a crack-aware model's inactive particles: 1, broken)
+    out = np.ones(basis.particles.n)
+    out[model.point_basis.families.masters] = share
+    return out
 
 
 def crack_line(basis, damage, threshold=0.5):

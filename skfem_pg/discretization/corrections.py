@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
+from scipy.sparse.csgraph import connected_components
 
 from . import vc_boundary
 from .vc_boundary import BOUNDARY_VARIANTS
@@ -169,10 +170,26 @@ def _solve_lsqr(A, b, tol, maxiter):
     return out[0], int(out[2])
 
 
-def anchor_particles(x, active):
+def anchor_particles(x, active, PhiT=None, masters=None):
     """``dim + 1`` active particles far apart and affinely independent
     (farthest-point choice): their equations and unknowns pin the singular
-    constraint system."""
+    constraint system.  With the scalar constraint matrix ``PhiT``
+    (particle × family) and the families' ``masters``, ``dim + 1`` in each
+    piece of particles that no family connects to another (a body cut
+    through by a crack, two bodies in one set): each piece has its own
+    linear fields in the matrix' left null space."""
+    if PhiT is not None:
+        n = x.shape[1]
+        P = sp.csr_matrix((np.ones(len(masters)), (np.arange(len(masters)),
+                                                   masters)),
+                          shape=(len(masters), n))
+        count, label = connected_components(
+            abs(PhiT.tocsr()) @ P + sp.eye(n, format="csr"), directed=False)
+        if count > 1:
+            act = np.asarray(active, bool)
+            return np.concatenate([
+                anchor_particles(x, act & (label == c))
+                for c in np.unique(label[act])])
     act = np.nonzero(active)[0]
     X = x[:, act].T
     d = X.shape[1]
@@ -277,10 +294,11 @@ def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
     With :math:`\beta^k = B^k\alpha^k` (``B^k`` is SPD) the system
     decouples into the scalar matrix :math:`\Phi^T` applied to each
     component of ``β`` — ``d³`` times cheaper to factorise than ``A``.
-    :math:`\Phi^T` is singular: the ``1 + d`` scalar linear fields are its
-    left null space, so the equations at ``d + 1`` affinely independent
-    anchor particles follow from the others and are dropped, and the
-    unknowns of the anchors' families are fixed to zero.  The reduced matrix
+    :math:`\Phi^T` is singular: the ``1 + d`` scalar linear fields of each
+    piece of particles that the families connect are its left null space,
+    so the equations at ``d + 1`` affinely independent anchor particles
+    per piece (:func:`anchor_particles`) follow from the others and are
+    dropped, and the unknowns of the anchors' families are fixed to zero.  The reduced matrix
     is regular (else ``RuntimeError``); its LU gives a particular solution
     and, with the fixed columns as right-hand sides, the null space
     :math:`z` of :math:`\Phi^T`.  The null space of ``A`` is
@@ -294,7 +312,7 @@ def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
     PhiT = PhiT.tocsr()
     family_of = np.full(n, -1)
     family_of[masters] = np.arange(nf)
-    anchors = anchor_particles(x, active)
+    anchors = anchor_particles(x, active, PhiT, masters)
     fix = family_of[anchors]
     rows = np.setdiff1d(np.nonzero(active)[0], anchors)
     cols = np.setdiff1d(np.arange(nf), fix)
@@ -337,14 +355,14 @@ def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
     if not min_norm:
         return (np.linalg.inv(B) @ beta[:, :, None])[..., 0].ravel(), its, \
             used
-    z = np.zeros((nf, d + 1))
+    z = np.zeros((nf, len(fix)))
     z[cols] = sol[:, d:]
-    z[fix, np.arange(d + 1)] = 1.0
+    z[fix, np.arange(len(fix))] = 1.0
     Binv = np.linalg.inv(B)
     alpha = (Binv @ beta[:, :, None])[..., 0].ravel()
     # null space of A: alpha^k = (B^k)^-1 e_a z^k, a = 1..d
-    Z = Binv[:, None, :, :] * z[:, :, None, None]  # (nf, d+1, d(out), d(a))
-    Z = Z.transpose(0, 2, 1, 3).reshape(nf * d, (d + 1) * d)
+    Z = Binv[:, None, :, :] * z[:, :, None, None]  # (nf, nz, d(out), d(a))
+    Z = Z.transpose(0, 2, 1, 3).reshape(nf * d, len(fix) * d)
     coef = np.linalg.lstsq(Z, alpha, rcond=None)[0]
     return alpha - Z @ coef, its, used
 

@@ -32,6 +32,9 @@ What a driver asks of a model is :class:`~.protocol.Model`
 ``bond_based``         :class:`BondBased`: bond-based peridynamics with
                        critical-stretch breaking (PMB), the classical
                        comparator on the same particles and drivers
+``crack_aware``        :class:`CrackAware`: the displacement formulation
+                       whose families stop at failed cells (beyond the
+                       thesis' 8.1)
 =====================  ====================================================
 """
 from .linear import linear_elasticity
@@ -47,6 +50,7 @@ from .tangents import fd_tangent
 from .history import History
 from .updated_lagrange import UpdatedLagrange
 from .bond_based import BondBased, segment_cut
+from .crack_aware import CrackAware
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
@@ -54,4 +58,4 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
            "History", "UpdatedLagrange", "Model", "BondBased",
-           "segment_cut"]
+           "segment_cut", "CrackAware"]

@@ -45,7 +45,10 @@ class Model(Protocol):
         cuts a step where it is not positive)."""
 
     def commit(self, state):
-        """A step converged at ``state``: commit internal variables."""
+        """A step converged at ``state``: commit internal variables.  A
+        model whose discretization changes here (crack-aware families
+        rebuilt) returns ``True``; the time integrators then evaluate its
+        internal force again before they use it."""
 
     def fields(self, x):
         """The model's extra fields of ``x`` by name (``{}`` if none)."""

@@ -47,7 +47,7 @@ from ..materials.hyperelastic import det
 from .displacement import Hyperelastic, internal_force, material_tangent
 
 
-def _point_keys(basis):
+def point_keys(basis):
     """``k * n + j`` for each flat point (family ``k``, member particle
     ``j``)."""
     fam = basis.families
@@ -59,7 +59,7 @@ def remap_points(old, new, arrays):
     """Point arrays (last axis flat over the points of ``old``) on the
     points of ``new``: the same (family, member) pair where it exists,
     else the family's master."""
-    ko, kn = _point_keys(old), _point_keys(new)
+    ko, kn = point_keys(old), point_keys(new)
     if ko.shape == kn.shape and np.array_equal(ko, kn):
         return arrays
     n = new.particles.n
@@ -72,6 +72,24 @@ def remap_points(old, new, arrays):
     master = np.searchsorted(ko[order], fam * n + fam)
     src = np.where(hit, src, order[np.minimum(master, len(ko) - 1)])
     return [a[..., src] for a in arrays]
+
+
+def carry_points(history, old, new, F):
+    """Carry the point data of basis ``old`` to the points of ``new``
+    (:func:`remap_points`): the committed arrays of ``history`` (a
+    :class:`~skfem_pg.formulations.history.History` or ``None``), in
+    place, and the deformation gradients ``F`` ``(d, d, 1, N_q)``, whose
+    remapped copy is returned."""
+    d = F.shape[0]
+    c = None if history is None else history.committed
+    names = sorted(c) if c is not None else []
+    arrays = remap_points(old, new, [np.asarray(F).reshape(d * d, -1)] + [
+        c[k].reshape(-1, c[k].shape[-1]) for k in names])
+    if c is not None:
+        history.committed = {k: a.reshape(c[k].shape[:-1] + (-1,))
+                             for k, a in zip(names, arrays[1:])}
+        history._last = None
+    return arrays[0].reshape(d, d, 1, -1)
 
 
 class UpdatedLagrange(Hyperelastic):
@@ -119,21 +137,8 @@ class UpdatedLagrange(Hyperelastic):
         particles = Particles.from_mesh(moved, elements=p0.elements)
         new = FamilyBasis(particles, **self.basis.options)
         F = self.state(u)["F"] if F is None else F
-        h = self.history
-        arrays = [F.reshape(d * d, -1)]
-        if h is not None and h.committed is not None:
-            names = sorted(h.committed)
-            arrays += [h.committed[k].reshape(-1, h.committed[k].shape[-1])
-                       for k in names]
-        arrays = remap_points(self.current, new, arrays)
-        Fn = arrays[0].reshape(d, d, 1, -1)
+        Fn = carry_points(self.history, self.current, new, F)
         self.F_c, self.J_c = Fn, det(Fn)
-        arrays = arrays[1:]
-        if h is not None and h.committed is not None:
-            shapes = {k: h.committed[k].shape for k in names}
-            h.committed = {k: a.reshape(shapes[k][:-1] + (-1,))
-                           for k, a in zip(names, arrays)}
-            h._last = None
         self.current = new
         self.u_c = np.array(u[:self.n_u], dtype=float)
         self.updates += 1

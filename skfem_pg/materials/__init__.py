@@ -7,9 +7,10 @@ from .hyperelastic import (Material, LinearElastic, StVenantKirchhoff,
                            NeoHooke, NeoHookeIsoVol, inverse_and_det)
 from .plasticity import J2Plasticity, ReturnMapError
 from .hardening import LinearSaturation, JohnsonCookHardening
-from .damage import JohnsonCookDamage
+from .damage import CriticalStrainDamage, JohnsonCookDamage
 
 __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
            "inverse_and_det", "J2Plasticity", "ReturnMapError",
-           "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage"]
+           "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage",
+           "CriticalStrainDamage"]

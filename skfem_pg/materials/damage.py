@@ -1,6 +1,7 @@
-r"""Ductile damage laws for the J2 material: an uncoupled damage indicator
+r"""Damage laws for the J2 material: an uncoupled damage indicator
 :math:`D` at every integration point that accumulates with the plastic
-strain and fails the point at a critical value (thesis 8.1).
+strain and fails the point at a critical value (thesis 8.1); and a
+brittle criterion on the elastic strain (:class:`CriticalStrainDamage`).
 
 :class:`JohnsonCookDamage` is Johnson and Cook's (1985) law without rate
 and temperature terms, as the thesis uses it:
@@ -72,6 +73,66 @@ class JohnsonCookDamage:
         with np.errstate(divide="ignore"):
             return np.where(ef > 0, da / np.where(ef > 0, ef, 1.0),
                             np.where(da > 0, np.inf, 0.0))
+
+
+class CriticalStrainDamage:
+    r"""A brittle failure criterion: a point fails when the largest
+    principal logarithmic strain of its trial elastic left Cauchy–Green
+    tensor :math:`b_e^{tr}` (the elastic strain where the point does not
+    yield) reaches ``critical_strain``,
+
+    .. math:: D = \max_{steps} rac{	frac12 \ln \lambda_{max}
+              (b_e^{tr})}{arepsilon_c}, \qquad 	ext{failure at }
+              D \ge D_c = 1,
+
+    the continuum counterpart of the bond-based model's critical stretch
+    [not in the thesis; used for Kalthoff–Winkler's brittle mode with a
+    yield stress the run does not reach].  A failed point is
+    :class:`~skfem_pg.materials.J2Plasticity`'s (no deviatoric stress, no
+    tension).  For a fracture energy :math:`G_0` and a crack one particle
+    spacing :math:`h` wide, :meth:`from_fracture_energy` gives
+    :math:`arepsilon_c = \sqrt{2 G_0 / (E h)}` (the energy of a linear
+    elastic band of width h strained to failure equals :math:`G_0` per
+    unit crack area) [crack-band scaling, a choice].
+
+    >>> law = CriticalStrainDamage(0.01)
+    >>> float(law.indicator(np.diag([1.02 ** 2, 1.0, 1.0])[None])[0])
+    ... # doctest: +ELLIPSIS
+    1.98...
+    """
+
+    Dc = 1.0
+
+    def __init__(self, critical_strain):
+        (self.critical_strain,) = check_finite(
+            "CriticalStrainDamage", critical_strain=critical_strain)
+        if not self.critical_strain > 0:
+            raise ValueError("CriticalStrainDamage: the critical strain must "
+                             "be positive, got {}".format(critical_strain))
+
+    @classmethod
+    def from_fracture_energy(cls, G0, E, h):
+        r"""The critical strain :math:`\sqrt{2 G_0/(E h)}` of a crack band
+        of width ``h`` (class docstring)."""
+        G0, E, h = check_finite("CriticalStrainDamage", G0=G0, E=E, h=h)
+        if not (G0 > 0 and E > 0 and h > 0):
+            raise ValueError("CriticalStrainDamage: G0, E and h must be "
+                             "positive, got {}, {}, {}".format(G0, E, h))
+        return cls(np.sqrt(2.0 * G0 / (E * h)))
+
+    def __repr__(self):
+        return "CriticalStrainDamage(critical_strain={:g})".format(
+            self.critical_strain)
+
+    def increment(self, dalpha, triaxiality):
+        """No accumulation with the plastic strain."""
+        return np.zeros(np.shape(dalpha))
+
+    def indicator(self, b):
+        r""":math:`	frac12\ln\lambda_{max}(b) / arepsilon_c` of
+        symmetric ``b`` ``(n, 3, 3)``."""
+        lam = np.linalg.eigvalsh(b)[:, -1]
+        return 0.5 * np.log(lam) / self.critical_strain
 
 
 def triaxiality(tau_dev, mean):

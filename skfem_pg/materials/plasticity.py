@@ -454,6 +454,9 @@ class Response:
                 damage[p] += m.damage.increment(alpha[p] - alpha_n[p],
                                                 triaxiality(tau_full[p],
                                                             vol[p]))
+            strain_law = getattr(m.damage, "indicator", None)
+            if strain_law is not None:  # a criterion on the elastic strain
+                damage = np.maximum(damage, strain_law(btr))
             failed = damage >= m.damage.Dc
             # the energy density a point failing now releases: what it
             # would store intact, less what it keeps (pressure in

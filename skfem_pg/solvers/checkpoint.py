@@ -140,18 +140,27 @@ def load(path, model, state=False):
         raise ValueError("checkpoint {} holds a history, the model's "
                          "material has none".format(path))
     if h is not None:
-        for k in set(saved) & set(h.committed or ()):
-            if saved[k].shape != np.shape(h.committed[k]):
-                raise ValueError(
-                    "checkpoint {}: history {!r} of shape {}, the model's "
-                    "has {}".format(path, k, saved[k].shape,
-                                    np.shape(h.committed[k])))
+        mismatch = getattr(h, "mismatch", None)
+        bad = (mismatch(saved) if mismatch is not None
+               else history_mismatch(h.committed, saved))
+        if bad:
+            raise ValueError("checkpoint {}: {}".format(path, bad))
         h.restore(saved or None)
     if not state:
         return x, lam
     extra = {k[len("state_"):]: (v[()] if v.ndim == 0 else v)
              for k, v in data.items() if k.startswith("state_")}
     return x, lam, extra
+
+
+def history_mismatch(committed, saved):
+    """Why the ``saved`` history arrays cannot replace ``committed`` (a
+    key whose shape differs), or ``None``."""
+    for k in sorted(set(saved) & set(committed or ())):
+        if saved[k].shape != np.shape(committed[k]):
+            return "history {!r} of shape {}, the model's has {}".format(
+                k, saved[k].shape, np.shape(committed[k]))
+    return None
 
 
 class Every:

@@ -194,11 +194,13 @@ def commit(model, state, t, x, v, hist):
     """``model.commit(state)`` after a step to ``t``; a model that cannot
     go on from there (an updated-Lagrangian rebuild on an inverted
     collocation mesh) stops the run with :class:`DynamicsError` at
-    ``t``."""
+    ``t``.  Returns whether the model's discretization changed (a model
+    whose ``commit`` returns ``True``: crack-aware families rebuilt), so
+    that the integrator evaluates the internal force again."""
     if not hasattr(model, "commit"):
-        return
+        return False
     try:
-        model.commit(state)
+        return bool(model.commit(state))
     except (ParticleError, FamilyError) as err:
         raise DynamicsError("the model could not be committed at t = "
                             "{:.6g}: {}".format(t, err), t=t, x=x, v=v,

@@ -87,8 +87,12 @@ def compression_since(F_est, F):
     shortest material line shrank); the highest frequency of an elastic
     body grows at most by it, so the estimated step is divided by it
     until the next estimate."""
-    if F_est is None or F is None or F_est.shape != F.shape:
+    if F_est is None or F is None:
         return 1.0
+    if F_est.shape != F.shape:
+        # the model's points changed (crack-aware families rebuilt): the
+        # step must be estimated again
+        return np.inf
     d = F.shape[0]
     Fi, _ = inverse_and_det(F.reshape(d, d, -1))
     R = np.einsum("ikp,kjp->ijp", F_est.reshape(d, d, -1), Fi)
@@ -286,7 +290,10 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         state = _evaluate(model, un, t + h, hist, v, u)
         fi_n = model.internal_force(state)
         t2 = time.perf_counter()
-        commit(model, state, t + h, u, v, hist)
+        if commit(model, state, t + h, u, v, hist):
+            # the families were rebuilt: the force of the new basis
+            state = _evaluate(model, un, t + h, hist, v, u)
+            fi_n = model.internal_force(state)
         times["commit"] += time.perf_counter() - t2
         times["force"] += t2 - t1
         fe_n = f_of(t + h)

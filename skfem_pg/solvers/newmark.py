@@ -207,7 +207,13 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
             continue
         xn, vn, an, fi_n, state, held_n, info = res
         fe_n = f_of(t + h)
-        commit(model, state, t + h, x, v, hist)
+        if commit(model, state, t + h, x, v, hist):
+            # the families were rebuilt: the force and the acceleration
+            # of the new basis (lumped mass)
+            state = model.state(xn)
+            fi_n = np.asarray(model.internal_force(state), dtype=float)
+            an, moving = np.array(an), free & ~held_n
+            an[moving] = (fe_n[:n_u] - fi_n[:n_u])[moving] / m[moving]
         touched = np.flatnonzero(held | held_n)
         energy.step(xn - x, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
                     free & ~held, free & ~held_n)

@@ -1,0 +1,413 @@
+r"""Crack-aware families: the displacement formulation whose families stop
+at the crack (beyond the thesis; its outlook, 8.1).
+
+In the thesis' total Lagrangian run with damage, a failed point carries no
+deviatoric stress and no tension, but the families keep their members: a
+family whose master lies on one side of a crack still differentiates the
+displacements of members on the other side, and the broken parts stay
+connected through their shape functions.  The thesis proposes to remove
+the members across the crack, to recompute the shape functions in the
+initial (semi-total Lagrangian) or current configuration, and to let the
+new crack surface enter the VC correction, only when needed.  This module
+does that on particles collocated from a mesh's vertices with the mesh
+family rule (the families are the vertices of the cells around the
+master):
+
+* **the crack is a set of failed cells** of the collocation mesh
+  [choice made here]: a cell fails when at least ``fraction`` of the
+  integration points :math:`(k, j)` it holds — master :math:`k` and
+  member :math:`j` both vertices of the cell — have failed
+  (:mod:`~skfem_pg.materials.damage`).  Pieces are cells connected
+  through facets (:func:`separate`): where two pieces touch at a vertex
+  only (a pinch, which the vertex' family would bridge; it makes the VC
+  system near-singular — measured: derivatives of 1e14 on the two-hole
+  plate), the cells of the smaller piece at that vertex fail too; a cell
+  of which the crack leaves two or more vertices with this cell alone (a
+  flap, held by one facet or less) fails too (with two such cells the VC
+  system of the two-hole plate left a residual of 6e-2, without them
+  1.5e-14); and a piece with fewer than
+  ``min_piece`` vertices fails whole (debris: its particles keep their
+  mass and move freely);
+* **the particles are collocated again from the intact cells**
+  (:meth:`Particles.from_mesh <skfem_pg.Particles.from_mesh>` with the
+  intact cells as the element subset): volumes are the intact cells'
+  lumped to their vertices, a vertex of no intact cell is inactive, and the
+  FE-consistent area vectors :math:`A^i` are those of the intact region's
+  boundary — **the crack faces included**, so the VC correction (5.18) of
+  the new basis integrates each piece's divergence theorem over its own
+  closed surface;
+* **the families, shape functions, bond and VC corrections are rebuilt**
+  with the basis' own options on these particles; the mesh rule then
+  builds the families from the intact cells, so no family spans a failed
+  cell.  The VC correction is the global solve of the basis (the cost of an
+  update, :attr:`CrackAware.update_seconds`); it runs only in steps in
+  which cells fail;
+* **semi-total Lagrangian gradients**: after an update at :math:`u_c`,
+
+  .. math::
+
+      F = F_c + \sum_i (u^i - u_c^i) \otimes G^{kji},
+
+  :math:`G` the rebuilt (reference) derivatives and :math:`F_c` the
+  committed deformation gradient at the update, carried per point
+  :math:`(k, j)` (a new point takes its master's); the deformation is
+  continuous across an update, and before the first update this is the
+  total Lagrangian formulation exactly.  The committed history follows
+  the points (:func:`~skfem_pg.formulations.updated_lagrange.
+  remap_points`);
+* **energy**: the stored energy of the points an update removes, and the
+  change of the remaining points' weights, is released: it is added to
+  :meth:`CrackAware.fracture_energy` (part of the dissipation an explicit
+  run records).  The second part has either sign: the quadrature weights
+  (4.30) of the members a family keeps can grow, and an update can add
+  stored energy (measured on the two-hole plate: up to 40 N mm at one
+  update, against 900 N mm stored).  The driver's energy balance does
+  not depend on it (it counts the work of the forces).
+
+The thesis' variant — connectivity kept — is the plain
+:class:`~skfem_pg.formulations.Hyperelastic` model on the same basis and
+material.  After an update :meth:`CrackAware.commit` returns ``True``, and
+the time integrators evaluate the internal force again on the new basis
+before they use it.
+"""
+import time
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ..discretization.assembly import assemble
+from ..discretization.basis import FamilyBasis
+from ..discretization.elementwise import Elements
+from ..discretization.particles import Particles
+from ..errors import FamilyError, describe_particle
+from ..threads import kernel
+from .displacement import Hyperelastic, internal_force, material_tangent
+from .history import History
+from .updated_lagrange import carry_points, point_keys
+
+
+def cell_failure(basis, cells, failed):
+    """The failed share of the integration points each cell holds: points
+    :math:`(k, j)` of ``basis`` with master ``k`` and member ``j`` both
+    vertices of the cell (``cells``: ``(n_vertices, n_cells)``);
+    ``failed``: per flat point of ``basis``."""
+    keys = point_keys(basis)
+    order = np.argsort(keys)
+    sk = keys[order]
+    n = basis.particles.n
+    q = (cells[:, None, :] * n + cells[None, :, :]).reshape(-1,
+                                                          cells.shape[1])
+    pos = np.minimum(np.searchsorted(sk, q), len(sk) - 1)
+    hit = sk[pos] == q
+    bad = hit & np.asarray(failed, bool).ravel()[order[pos]]
+    return bad.sum(axis=0) / np.maximum(hit.sum(axis=0), 1)
+
+
+def pieces(mesh, intact):
+    """The pieces of the ``intact`` cells of ``mesh`` (cells sharing a
+    facet are connected): ``(label per intact cell, cells per piece)``."""
+    idx = np.flatnonzero(intact)
+    if idx.size == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    a, b = mesh.f2t
+    both = (b >= 0) & intact[a] & intact[np.maximum(b, 0)]
+    local = np.full(intact.shape[0], -1)
+    local[idx] = np.arange(idx.size)
+    G = sp.csr_matrix((np.ones(both.sum()), (local[a[both]],
+                                             local[b[both]])),
+                      shape=(idx.size, idx.size))
+    _, label = connected_components(G, directed=False)
+    return label, np.bincount(label)
+
+
+def separate(mesh, intact, min_piece):
+    """The intact cells after the pieces are made clean: a vertex whose
+    cells belong to more than one piece (two pieces touching at a vertex,
+    a pinch that a family would bridge) keeps the cells of its largest
+    piece only; a cell with two or more vertices that the crack has left
+    with this cell alone (a flap, held by one facet or less) goes too;
+    pieces with fewer than ``min_piece`` vertices go (debris).  Repeated
+    until nothing changes (at most once per cell)."""
+    intact = intact.copy()
+    nv = mesh.p.shape[1]
+    cells_at = np.bincount(mesh.t.ravel(), minlength=nv)
+    for _ in range(intact.size + 1):
+        idx = np.flatnonzero(intact)
+        label, size = pieces(mesh, intact)
+        t = mesh.t[:, idx]
+        left = np.bincount(t.ravel(), minlength=nv)
+        alone = (left == 1) & (cells_at > 1)  # the crack took the others
+        # vertices per piece, and the pieces at each vertex
+        at = sp.csr_matrix((np.ones(t.size, bool), (t.ravel(), np.tile(
+            label, t.shape[0]))), shape=(nv, size.size))
+        at.sum_duplicates()
+        drop = alone[t].sum(axis=0) >= 2  # flaps
+        verts = np.diff(at.tocsc().indptr)
+        drop |= verts[label] < min_piece
+        pinch = np.flatnonzero(np.diff(at.indptr) > 1)
+        if pinch.size:
+            # at each pinch the cells of all but its largest piece go
+            rows = at[pinch].tocoo()
+            best = np.zeros(pinch.size, int)
+            key = size[rows.col] * (size.size + 1) + rows.col
+            order = np.lexsort((key, rows.row))
+            last = np.r_[np.diff(rows.row[order]) != 0, True]
+            best[rows.row[order][last]] = rows.col[order][last]
+            keep_piece = np.full(nv, -1)
+            keep_piece[pinch] = best
+            touches = keep_piece[t]  # (corners, cells)
+            drop |= np.any((touches >= 0) & (touches != label[None]),
+                           axis=0)
+        if not drop.any():
+            return intact
+        intact[idx[drop]] = False
+    return intact
+
+
+class _CrackHistory(History):
+    """The material's history plus the crack (intact cells, the update's
+    :math:`u_c`, :math:`F_c` and released energy) in checkpoints: a
+    restore rebuilds the model's basis on the saved intact cells before
+    the point arrays are restored."""
+
+    def __init__(self, material, model):
+        super().__init__(material)
+        self._model = model
+
+    def save(self):
+        out = super().save() or {}
+        m = self._model
+        out["crack_intact"] = m.intact.astype(float)
+        out["crack_u_c"] = m.u_c.copy()
+        out["crack_released"] = np.array(m.released_at_updates)
+        out["crack_n_failed"] = np.array(float(m._n_failed))
+        if m.F_c is not None:
+            out["crack_F_c"] = np.array(m.F_c)
+        return out
+
+    def mismatch(self, saved):
+        """Why a checkpoint's arrays do not fit this model (its crack on
+        another mesh), or ``None``: the point arrays are checked against
+        the basis the crack rebuilds, in :meth:`restore`."""
+        intact = saved.get("crack_intact")
+        if intact is None:
+            return "the checkpoint holds no crack (not a CrackAware run)"
+        if intact.shape != self._model.intact.shape:
+            return "its crack has {} cells, the mesh {}".format(
+                intact.shape[0], self._model.intact.shape[0])
+        return None
+
+    def restore(self, saved):
+        saved = dict(saved or {})
+        crack = {k: saved.pop(k) for k in list(saved)
+                 if k.startswith("crack_")}
+        if crack:
+            self._model._restore(crack)
+        n = self._model.current.flat_weights().shape[-1]
+        for k, v in saved.items():
+            if np.shape(v)[-1] != n:
+                raise ValueError("history {!r} at {} points, the rebuilt "
+                                 "basis has {}".format(k, np.shape(v)[-1],
+                                                       n))
+        super().restore(saved or None)
+
+
+class CrackAware(Hyperelastic):
+    """The displacement formulation whose families stop at failed cells
+    (module docstring) on ``basis`` (a PBG :class:`~skfem_pg.FamilyBasis`
+    collocated from a mesh's vertices with the ``"mesh"`` family rule) with
+    ``material``, a :class:`~skfem_pg.materials.J2Plasticity` with a damage
+    law.
+
+    ``fraction``: the failed share of its points at which a cell fails;
+    ``min_piece``: pieces cut off with fewer vertices fail whole (default
+    ``dim + 2``, the smallest family a VC-corrected basis takes).
+
+    ``model.basis`` stays the basis of the whole body (dofs, loads,
+    Dirichlet boundaries); ``model.current`` is the basis on the intact
+    cells, ``model.intact`` the mask of the mesh's intact cells.
+    ``updates``, ``update_seconds`` and ``update_log`` (per update: the
+    cells failed and the seconds) say how often the families were rebuilt
+    and what it cost."""
+
+    def __init__(self, basis, material, fraction=0.5, min_piece=None):
+        if not isinstance(basis, FamilyBasis) or basis.is_petrov:
+            raise ValueError("crack-aware families are built for PBG family "
+                             "bases, got {}".format(type(basis).__name__))
+        p = basis.particles
+        if p.kind != "vertices" or p.mesh is None:
+            raise ValueError("crack-aware families remove failed cells of "
+                             "the collocation mesh: the particles must be "
+                             "a mesh's vertices (Particles.from_mesh)")
+        if basis.options.get("families") != "mesh":
+            raise ValueError(
+                "crack-aware families rebuild the families from the intact "
+                "cells: the basis needs the 'mesh' family rule, got {!r}"
+                .format(basis.spec.families))
+        damage = getattr(material, "damage", None)
+        if not getattr(material, "stateful", False) or damage is None:
+            raise ValueError("{!r} has no damage law: nothing can fail "
+                             "(J2Plasticity(..., damage=JohnsonCookDamage"
+                             "(...)))".format(material))
+        if not 0.0 < float(fraction) <= 1.0:
+            raise ValueError("fraction must be in (0, 1], got {!r}".format(
+                fraction))
+        super().__init__(basis, material)
+        self.material = _CrackHistory(material, self)
+        self.fraction = float(fraction)
+        d = p.dim
+        self.min_piece = d + 2 if min_piece is None else int(min_piece)
+        if self.min_piece < d + 1:
+            raise ValueError("min_piece must be at least dim + 1 = {}, got "
+                             "{}".format(d + 1, min_piece))
+        mesh = p.mesh
+        self.intact = np.zeros(mesh.t.shape[1], dtype=bool)
+        self.intact[np.arange(mesh.t.shape[1]) if p.elements is None
+                    else p.elements] = True
+        self.current = basis
+        self.u_c = np.zeros(basis.N)
+        self.F_c = None  # the identity until the first update
+        self.released_at_updates = 0.0
+        self.updates, self.update_seconds, self.update_log = 0, 0.0, []
+        self._n_failed = 0
+
+    # -- the crack ------------------------------------------------------
+    def cells_to_fail(self, failed):
+        """The intact cells that fail with the points ``failed`` (per flat
+        point of :attr:`current`), debris included (module
+        docstring)."""
+        mesh = self.basis.particles.mesh
+        idx = np.flatnonzero(self.intact)
+        share = cell_failure(self.current, mesh.t[:, idx], failed)
+        fail = np.zeros_like(self.intact)
+        fail[idx[share >= self.fraction - 1e-12]] = True
+        if not fail.any():
+            return fail
+        return self.intact & ~separate(mesh, self.intact & ~fail,
+                                       self.min_piece)
+
+    def update(self, u, F, fail):
+        """Fail the cells ``fail`` at the displacements ``u`` (the
+        committed point gradients ``F`` on :attr:`current`): collocate,
+        rebuild, carry :math:`F` and the history over and book the
+        released energy."""
+        t0 = time.perf_counter()
+        mesh = self.basis.particles.mesh
+        intact = self.intact & ~fail
+        if not intact.any():
+            raise FamilyError("every cell of the collocation mesh has "
+                              "failed: nothing is left to build families on")
+        before = self._stored_and_released(F)
+        particles = Particles.from_mesh(mesh,
+                                        elements=np.flatnonzero(intact))
+        new = FamilyBasis(particles, **self.basis.options)
+        self._check_pieces(new, intact)
+        F_new = carry_points(self.history, self.current, new, F)
+        self.current, self.intact = new, intact
+        self.F_c, self.u_c = F_new, np.array(u[:self.n_u], dtype=float)
+        after = self._stored_and_released(F_new)
+        self.released_at_updates += before - after
+        self.updates += 1
+        seconds = time.perf_counter() - t0
+        self.update_seconds += seconds
+        self.update_log.append({"cells": int(fail.sum()),
+                                "seconds": seconds,
+                                "vc": float(new.timings.get("vc", 0.0))})
+        return new
+
+    def _stored_and_released(self, F):
+        """:math:`\\sum w\\, (W(F) + \\text{released})` on :attr:`current`
+        (the energy an update must account for)."""
+        stored = float(np.sum(self.current.flat_weights()
+                              * self.material.energy(F)))
+        r = self.history.released()
+        return stored + (0.0 if r is None else
+                         float(Elements(self.current).sum(r).sum()))
+
+    def _check_pieces(self, new, intact):
+        """No family may reach across a failed cell into another piece
+        (the mesh rule enlarges a small family ring by ring, then by its
+        nearest particles): raise :class:`FamilyError` naming the first
+        master whose family does."""
+        mesh = self.basis.particles.mesh
+        cells = np.flatnonzero(intact)
+        label, _ = pieces(mesh, intact)
+        vertex = np.full(mesh.p.shape[1], -1)
+        vertex[mesh.t[:, cells].ravel()] = np.repeat(
+            label[None], mesh.t.shape[0], axis=0).ravel()
+        fam = new.families
+        k = np.repeat(fam.masters, fam.sizes)
+        bad = vertex[np.asarray(fam.members)] != vertex[k]
+        if bad.any():
+            m = k[np.flatnonzero(bad)[0]]
+            raise FamilyError(
+                "the family of {} reaches across the crack (it was "
+                "enlarged beyond its piece of intact cells)".format(
+                    describe_particle(m, mesh.p[:, m])))
+
+    def _restore(self, crack):
+        """Rebuild the basis on a checkpoint's intact cells."""
+        intact = np.asarray(crack["crack_intact"]) > 0.5
+        self.intact = intact
+        if self.updates or not intact.all():
+            particles = Particles.from_mesh(
+                self.basis.particles.mesh, elements=np.flatnonzero(intact))
+            self.current = FamilyBasis(particles, **self.basis.options)
+        self.u_c = np.asarray(crack["crack_u_c"], dtype=float)
+        F = crack.get("crack_F_c")
+        self.F_c = None if F is None else np.asarray(F, dtype=float)
+        self.released_at_updates = float(crack["crack_released"])
+        self._n_failed = int(crack["crack_n_failed"])
+
+    # -- the model ------------------------------------------------------
+    def commit(self, state):
+        """Commit the step's history; where points failed, fail the cells
+        they take with them and rebuild (:meth:`update`).  Returns whether
+        the basis changed (the drivers then evaluate the internal force
+        again)."""
+        super().commit(state)
+        failed = self.history.failed()
+        if failed is None:
+            return False
+        n = int(failed.sum())
+        if n == self._n_failed:
+            return False
+        self._n_failed = n
+        fail = self.cells_to_fail(failed)
+        if not fail.any():
+            return False
+        self.update(state["u"], np.array(state["F"]), fail)
+        self._n_failed = int(self.history.failed().sum())
+        return True
+
+    @property
+    def point_basis(self):
+        """The basis on the intact cells: its points carry the history."""
+        return self.current
+
+    def fracture_energy(self):
+        """What the failed points released, plus what the updates released
+        (module docstring)."""
+        return super().fracture_energy() + self.released_at_updates
+
+    @kernel
+    def state(self, u):
+        dF = self.current.interpolate(u[:self.n_u] - self.u_c,
+                                      flat=True).grad
+        return {"F": dF + (self._eye if self.F_c is None else self.F_c),
+                "u": u}
+
+    def energy(self, state):
+        return float(np.sum(self.current.flat_weights()
+                            * self.material.energy(state["F"])))
+
+    @kernel
+    def internal_force(self, state):
+        return assemble(internal_force, self.current,
+                        P=self.stress(state))
+
+    @kernel
+    def tangent(self, state):
+        return assemble(material_tangent, self.current,
+                        A=self.material.tangent(state["F"]))
