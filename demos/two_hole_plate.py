@@ -204,6 +204,9 @@ def plot(results, mesh, fn):
             tri = np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]])
             ax.tripcolor(*(mesh.p + U), tri.T, D, shading="gouraud",
                          vmin=0, vmax=1, cmap="inferno_r")
+            x = (mesh.p + U)[:, np.unique(q)]  # not the debris' flight
+            ax.set_xlim(x[0].min() - 1, x[0].max() + 1)
+            ax.set_ylim(x[1].min() - 1, x[1].max() + 1)
             ax.set_aspect("equal")
             ax.set_axis_off()
             ax.set_title("{}\nt = {:.2g} ms".format(r["method"], 1e3 * t),
