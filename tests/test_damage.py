@@ -228,9 +228,9 @@ def test_first_yield_under_power_law_hardening_converges():
 def test_formulations_carry_damage_and_the_mixed_ones_refuse_it():
     """Unl keeps damage at every family member and reports the failed
     ones; U1SIG at the masters, and a failed master loses its
-    stabilization too (its moduli are zero, the others' untouched); UnlP0
-    and FE Q1P0, which add the pressure per family or cell, refuse a
-    damage law by name."""
+    stabilization too (its moduli are zero, the others' untouched); PPG
+    UnlP0 and IUnlP0, which carry the pressure at the master or as an
+    unknown, refuse a damage law by name."""
     import skfem as fem
 
     import skfem_pg as pg
@@ -252,11 +252,14 @@ def test_formulations_carry_damage_and_the_mixed_ones_refuse_it():
     mu_f, K_f = u1sig.frozen()[:2]
     assert mu_f[3] == 0 and K_f[3] == 0
     assert np.array_equal(np.delete(mu_f, 3), np.delete(mu, 3))
-    with pytest.raises(NotImplementedError, match="UnlP0"):
-        model_for("UnlP0", basis, steel)
-    fe = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
-    with pytest.raises(NotImplementedError, match="Q1P0"):
-        model_for("Q1P0", fe, steel)
+    # the mixed formulations that carry the pressure elsewhere refuse
+    ppg = pg.FamilyBasis(mesh, dim=2, method="PPG1")
+    with pytest.raises(NotImplementedError, match="MeanDilatation"):
+        model_for("UnlP0", ppg, steel)
+    incompressible = J2Plasticity(steel.mu, np.inf, hardening=JC,
+                                  damage=JC_DAMAGE)
+    with pytest.raises(NotImplementedError, match="MeanDilatation"):
+        model_for("IUnlP0", basis, incompressible)
 
 
 def test_the_critical_strain_criterion_fails_at_its_strain():
@@ -281,3 +284,50 @@ def test_the_critical_strain_criterion_fails_at_its_strain():
             np.sqrt(2 * 22.17 / 190e3))
     with pytest.raises(ValueError, match="positive"):
         CriticalStrainDamage(0.0)
+
+
+@pytest.mark.parametrize("element", ["Q1P0", "UnlP0"])
+def test_mean_dilatation_carries_damage_as_the_displacement_law(element):
+    """Q1P0 (and PBG UnlP0) under a homogeneous stretch in plane strain:
+    the element pressure K/2 (Theta - 1/Theta) times J is the law's own
+    mean stress, so the damage and the failure step are the displacement
+    formulation's (Q1 / Unl) to round-off; once every point has failed,
+    the element carries no tension (its volumetric stress vanishes in
+    expansion) and keeps its pressure in compression."""
+    import skfem as fem
+
+    import skfem_pg as pg
+    from skfem_pg.formulations import model_for
+    mesh = fem.MeshQuad.init_tensor(*(np.linspace(0, 1, 3),) * 2)
+    if element == "Q1P0":
+        basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+        plain = "Q1"
+    else:
+        basis = pg.FamilyBasis(mesh, dim=2)
+        plain = "Unl"
+    steel = J2Plasticity.from_young(E, NU, hardening=JC, damage=JC_DAMAGE)
+    mixed, disp = model_for(element, basis, steel), model_for(plain, basis,
+                                                               steel)
+    X = basis.doflocs
+    comp = np.arange(basis.N) % 2
+
+    def affine(F):
+        return np.einsum("ij,jn->in", F - np.eye(2), X)[comp,
+                                                       np.arange(basis.N)]
+    fail_step = {}
+    for step, lam in enumerate(np.linspace(1.01, 1.6, 40)):
+        u = affine(np.diag([lam, 1.0 / lam ** 0.3]))
+        sm, sd = mixed.state(u), disp.state(u)
+        Dm = mixed.history.response(sm["F"]).history["damage"]
+        Dd = disp.history.response(sd["F"]).history["damage"]
+        assert np.abs(Dm - Dd).max() <= 1e-10 * max(1.0, Dd.max())
+        for name, m, s_ in (("mixed", mixed, sm), ("disp", disp, sd)):
+            m.commit(s_)
+            if m.failed().all() and name not in fail_step:
+                fail_step[name] = step
+    assert fail_step["mixed"] == fail_step["disp"]
+    # failed everywhere: no stress in expansion, pressure in compression
+    for F, carries in ((np.diag([1.65, 0.9]), False),
+                       (np.diag([0.95, 0.95]), True)):
+        P = mixed.stress(mixed.state(affine(F)))
+        assert (np.abs(P).max() > 1.0) == carries

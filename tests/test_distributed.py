@@ -368,3 +368,22 @@ def test_parallel_vtu():
     assert cells == mesh.nelements
     with pytest.raises(ValueError, match="pvtu"):
         dist.write_pvtu(os.path.join(root, "cube.vtu"), part, u=u)
+
+
+def test_a_set_in_pieces_on_ranks():
+    """Two bodies in one particle set: rank 0's pinned solve pins each
+    piece (the patch test holds on both); the all-ranks solve, which pins
+    one piece, refuses by name."""
+    a = fem.MeshTri.init_tensor(np.linspace(0, 1, 7), np.linspace(0, 1, 6))
+    b = fem.MeshTri.init_tensor(np.linspace(2, 3, 6), np.linspace(0, 1, 8))
+    both = fem.MeshTri(np.hstack([a.p, b.p]),
+                       np.hstack([a.t, b.t + a.p.shape[1]]))
+    part = dist.Partition(both, COMM)
+    with pytest.raises(NotImplementedError, match="2 pieces"):
+        part.basis(dim=2, vc_solver="petsc")
+    basis = part.basis(dim=2, vc_solver="direct")
+    assert basis.vc_report.residual_after < 1e-12
+    D = fem.Basis(both, fem.ElementVector(fem.ElementTriP1())).get_dofs()
+    uex = (GEX @ both.p).T.ravel()
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, D=D, u_D=uex)
+    assert np.abs(u - uex).max() <= 1e-10

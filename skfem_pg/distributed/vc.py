@@ -26,6 +26,7 @@ import time
 
 import numpy as np
 import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from . import petsc as pt
 from .comm import mpi, petsc
@@ -55,6 +56,29 @@ def _ksp(M, part):
     ksp.setTolerances(rtol=RTOL, atol=0.0, max_it=5000)
     ksp.setFromOptions()
     return ksp
+
+
+def _refuse_pieces(part, rows, masters, active):
+    """``NotImplementedError`` where the particles fall into several
+    pieces that no family connects: all ranks' solve (:func:`solve_pinned`)
+    pins the linear fields of one piece, and the others' corrections would
+    not be the minimum-norm ones (rank 0's solve pins each piece)."""
+    got = part.comm.gather((rows, masters), root=0)
+    count = None
+    if part.rank == 0:
+        r = np.concatenate([g[0] for g in got])
+        c = np.concatenate([g[1] for g in got])
+        n = part.n
+        G = sp.csr_matrix((np.ones(len(r)), (r, c)), shape=(n, n))
+        _, label = connected_components(G, directed=False)
+        count = len(np.unique(label[np.asarray(active, bool)]))
+    count = part.comm.bcast(count, root=0)
+    if count > 1:
+        raise NotImplementedError(
+            "vc_solver='petsc' pins the linear fields of one piece; these "
+            "particles fall into {} pieces that no family connects: use "
+            "vc_solver='direct' or 'amg' (rank 0 pins each piece)"
+            .format(count))
 
 
 def solve_pinned(part, rows, cols, vals, fid, B, b, anchors, min_norm=True):
@@ -174,6 +198,7 @@ def vc_correction(part, G, dx, x, volumes, fam, area, phi, variant="V5",
             .format(solver))
     if solver == "petsc":
         mp = part.local[masters_l]  # the families' master particles
+        _refuse_pieces(part, rows, mp[PhiT.col], active)
         al, its = solve_pinned(
             part, rows, mp[PhiT.col], PhiT.data, mp, B_l,
             b.reshape(-1, d), anchor_particles(xg, active),

@@ -40,6 +40,17 @@ a term of rank ``q`` (1 or d + 1) per element
 (:class:`~skfem_pg.discretization.elementwise.Elements`, batched over size
 groups).  PPG UnlP0 (the master evaluation :math:`\Theta^k = J^{kk}`) is
 :mod:`.master_dilatation`.
+
+With a damage law (:mod:`~skfem_pg.materials.damage`) the isochoric law
+at the points takes :math:`\tau_m = J p` as its mean stress for the
+triaxiality — under a homogeneous deformation the law's own
+:math:`\tfrac K2(J^2 - 1)`, so the damage is the displacement
+formulation's — and a failed point's no-tension rule acts on the
+element [choice made here]: where :math:`\Theta \ge 1` the volumetric
+energy is :math:`(1 - \phi_e)\,U(\Theta)`, :math:`\phi_e` the weighted
+share of the element's points failed in the committed history (frozen
+during a step; :math:`U'(1) = 0` keeps the pressure continuous at
+:math:`\Theta = 1`); in compression the element keeps all of it.
 """
 import numpy as np
 
@@ -48,6 +59,7 @@ from ..discretization.elementwise import Elements
 from ..materials import J2Plasticity, NeoHookeIsoVol, inverse_and_det
 from ..threads import kernel
 from .displacement import Hyperelastic, material_tangent
+from .history import History
 
 
 def d_JFinvT(J, Finv):
@@ -104,6 +116,29 @@ class MeanDilatation(Hyperelastic):
             "U2P1)")
         return cls(basis, mu, K, order=order).with_material(material)
 
+    def with_material(self, material):
+        """Bind the isochoric part of ``material`` (the volumetric part is
+        this formulation's); a damage law comes along: the points get the
+        element pressure for their triaxiality, and the element's
+        volumetric energy loses its failed share in tension (module
+        docstring)."""
+        if getattr(material, "stateful", False):
+            self.material = History(material.isochoric(with_damage=True))
+        return self
+
+    def tension_share(self):
+        """Per element, the share of its points (by weight) that have not
+        failed in the committed history, spread to the points; ``None``
+        without a damage law."""
+        h = self.history
+        if h is None or getattr(h.material, "damage", None) is None:
+            return None
+        failed = h.failed()
+        if failed is None:  # before the first evaluation: all intact
+            return 1.0
+        E = self.elements
+        return E.spread(1.0 - E.sum(failed.astype(float)) / E.volumes)
+
     def project(self, a):
         """Coefficients ``(n, q)`` of the weighted L2 projection of point
         data ``a`` onto each element's polynomials."""
@@ -124,9 +159,16 @@ class MeanDilatation(Hyperelastic):
         Finv, J = inverse_and_det(s["F"])
         c_Theta = self.project(J)
         Theta = self.evaluate(c_Theta)
-        c_p = self.project(self.pressure(Theta))
+        share = self.tension_share()
+        # failed points carry no tension: in expansion the element keeps
+        # the volumetric energy of its intact share (U'(1) = 0: continuous)
+        scale = 1.0 if share is None else np.where(Theta >= 1.0, share,
+                                                    1.0)
+        c_p = self.project(scale * self.pressure(Theta))
         s.update(Finv=Finv, J=J, Theta=Theta, c_Theta=c_Theta, c_p=c_p,
-                 p=self.evaluate(c_p))
+                 p=self.evaluate(c_p), scale=scale)
+        if share is not None:  # the points' triaxiality: tau_m = J p
+            self.history.bind_mean_stress(s["F"], s["J"] * s["p"])
         return s
 
     def min_J(self, state):
@@ -134,7 +176,7 @@ class MeanDilatation(Hyperelastic):
 
     def energy(self, state):
         Th = state["Theta"]
-        U = 0.25 * self.K * (Th ** 2 - 1 - 2 * np.log(Th))
+        U = 0.25 * self.K * (Th ** 2 - 1 - 2 * np.log(Th)) * state["scale"]
         return super().energy(state) + float(np.sum(self.elements.sum(U)))
 
     def fields(self, x):
@@ -157,7 +199,7 @@ class MeanDilatation(Hyperelastic):
         U''\\Phi) M^{-1} C_e`."""
         E = self.elements
         Th = state["Theta"]
-        Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
+        Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2) * state["scale"]
         S = self._Minv @ E.gram(self.Phi, Upp) @ self._Minv
         C = E.moments(state["J"] * np.swapaxes(state["Finv"], 0, 1),
                       self.Phi)

@@ -40,6 +40,7 @@ class History:
         self.material = material
         self.committed = None
         self._last = None  # (F, response)
+        self._mean = None  # (F, mean stress): bind_mean_stress
 
     def __repr__(self):
         return "History({!r})".format(self.material)
@@ -55,12 +56,26 @@ class History:
                 "integration points".format(
                     self.material, self.committed["alpha"].shape, shape))
 
+    def bind_mean_stress(self, F, mean_stress):
+        """Evaluate the points at ``F`` (this very array) with the mean
+        (Kirchhoff) stress ``mean_stress`` for the damage law's
+        triaxiality: a mixed formulation's pressure, which the isochoric
+        law does not see (:class:`~skfem_pg.formulations.
+        MeanDilatation`)."""
+        self._mean = (F, mean_stress)
+        if self._last is not None and self._last[0] is F:
+            self._last = None
+
     def response(self, F):
         """The material's response to ``F`` from the committed state."""
         if self._last is not None and self._last[0] is F:
             return self._last[1]
         self._check(F)
-        r = self.material.update(F, self.committed)
+        if self._mean is not None and self._mean[0] is F:
+            r = self.material.update(F, self.committed,
+                                     mean_stress=self._mean[1])
+        else:
+            r = self.material.update(F, self.committed)
         self._last = (F, r)
         return r
 

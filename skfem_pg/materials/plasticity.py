@@ -173,20 +173,25 @@ class J2Plasticity(Material):
         mu = E / (2 * (1 + nu))
         return cls(mu, E / (3 * (1 - 2 * nu)), sigma_y0, **kw)
 
-    def isochoric(self):
+    def isochoric(self, with_damage=False):
         """The same law without the volumetric part (``K = 0``), for the
         mixed formulations that add it per element or particle; the
-        return map does not depend on ``K``.  Not with damage: a failed
-        point's no-tension rule acts on the pressure, which those
-        formulations carry."""
-        if self.damage is not None:
+        return map does not depend on ``K``.  With damage only for a
+        formulation that says it carries it (``with_damage``: it gives
+        the points their mean stress for the triaxiality, ``mean_stress``
+        of :meth:`update`, and applies the no-tension rule to its
+        pressure itself — :class:`~skfem_pg.formulations.MeanDilatation`);
+        for the others a failed point's rule would act on a pressure they
+        carry elsewhere."""
+        if self.damage is not None and not with_damage:
             raise NotImplementedError(
                 "{!r}: damage needs the pressure at the point (a failed "
-                "point carries no tension); the mixed formulations that add "
-                "the pressure per element or particle (UnlP0, IUnlP0, "
-                "Q1P0/H1P0) do not take it yet: use Unl, U1SUnl, U1SIG or "
-                "FE Q1/H1/T1/O1".format(self))
-        m = J2Plasticity(self.mu, 1.0, hardening=self.hardening)
+                "point carries no tension); of the mixed formulations that "
+                "add the pressure per element or particle only PBG UnlP0 "
+                "and FE Q1P0/H1P0 (MeanDilatation) take it: use those, "
+                "Unl, U1SUnl, U1SIG or FE Q1/H1/T1/O1".format(self))
+        m = J2Plasticity(self.mu, 1.0, hardening=self.hardening,
+                         damage=self.damage)
         m.K = 0.0
         return m
 
@@ -225,12 +230,14 @@ class J2Plasticity(Material):
         return h
 
     # -- the stress update ---------------------------------------------
-    def update(self, F, history):
+    def update(self, F, history, mean_stress=None):
         """The response to ``F`` ``(d, d, ...)`` from the committed
         ``history`` at the same points: a :class:`Response` with the
         stress ``P``, the trial history and (on demand) the algorithmic
-        tangent."""
-        return Response(self, F, history)
+        tangent.  ``mean_stress`` (per point, Kirchhoff): the mean stress
+        the damage law's triaxiality takes instead of the law's own
+        volumetric one (a mixed formulation's pressure, times J)."""
+        return Response(self, F, history, mean_stress)
 
     # stateless use (the virgin state): what the elastic formulations and
     # the hyperelastic checks call
@@ -373,7 +380,7 @@ class Response:
     commits), ``plastic`` (where the step yields), :meth:`tangent` and
     :meth:`energy`."""
 
-    def __init__(self, material, F, history):
+    def __init__(self, material, F, history, mean_stress=None):
         self.material = m = material
         self.F = F
         d = F.shape[0]
@@ -450,10 +457,12 @@ class Response:
         vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
         failed = np.zeros(n, dtype=bool)
         if m.damage is not None:
+            mean = vol if mean_stress is None else np.broadcast_to(
+                np.asarray(mean_stress, dtype=float).reshape(-1), (n,))
             if p.size:
                 damage[p] += m.damage.increment(alpha[p] - alpha_n[p],
                                                 triaxiality(tau_full[p],
-                                                            vol[p]))
+                                                            mean[p]))
             strain_law = getattr(m.damage, "indicator", None)
             if strain_law is not None:  # a criterion on the elastic strain
                 damage = np.maximum(damage, strain_law(btr))
