@@ -8,7 +8,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.discretization.elementwise import Elements
-from skfem_pg.formulations import Hyperelastic, model_for
+from skfem_pg.formulations import model_for
 from skfem_pg.formulations.bond_based import BondBased, segment_cut
 from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
                                 JohnsonCookHardening)
