@@ -298,10 +298,10 @@ def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
     piece of particles that the families connect are its left null space,
     so the equations at ``d + 1`` affinely independent anchor particles
     per piece (:func:`anchor_particles`) follow from the others and are
-    dropped, and the unknowns of the anchors' families are fixed to zero.  The reduced matrix
-    is regular (else ``RuntimeError``); its LU gives a particular solution
-    and, with the fixed columns as right-hand sides, the null space
-    :math:`z` of :math:`\Phi^T`.  The null space of ``A`` is
+    dropped, and the unknowns of the anchors' families are fixed to zero.
+    The reduced matrix is regular (else ``RuntimeError``); its LU gives a
+    particular solution and, with the fixed columns as right-hand sides,
+    the null space :math:`z` of :math:`\Phi^T`.  The null space of ``A`` is
     :math:`\{B^{-1}(z\,e_a)\}`; projecting it out gives the minimum-norm
     ``α``.  With ``iterative`` the reduced matrix is solved by AMG-GMRES
     (:class:`_AMGSolve`) instead, falling back to the LU if it does not
