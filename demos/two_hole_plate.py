@@ -234,7 +234,7 @@ def main():
                     help="Table 7.1 names and FEM Q1")
     args = ap.parse_args()
     if args.quick:
-        args.h, args.t_end = 4.0, 2e-4
+        args.h, args.t_end = 4.0, 3e-4
     out = output_dir(args.out)
     mesh = from_geo(geo_path("plate_two_holes.geo"), size=args.h,
                     recombine=True)
