@@ -103,7 +103,7 @@ SCRIPTS = [
      "thesis 8.1 / Fig. 8.1: ductile fracture of a plate with two holes, "
      "Johnson–Cook damage on PG U1SIG and Unl (connectivity kept, and "
      "crack-aware families) beside FE Q1 erosion; crack snapshots, bottom "
-     "force and energies; VTU series", "15 min", 900),
+     "force and energies; VTU series", "14 min", 840),
     ("kalthoff_winkler", ["demos/kalthoff_winkler.py"],
      "Kalthoff–Winkler impact with the bond-based comparator (PMB) and PG "
      "Unl with a brittle criterion (connectivity kept, crack-aware): the "

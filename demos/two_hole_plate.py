@@ -18,17 +18,20 @@ D1 = 0.05, D2 = 3.44, D3 = -2.12, failure at Dc = 0.3
 stress and no tension).  Units N, mm, s (density in t/mm^3).
 
 Models on the nodes of one gmsh quad mesh: the thesis' ``VCPBG V3m
-U1SIG`` (connectivity kept across the crack, as in the thesis); PG Unl
-(``VCBCPBG V5sn Unl``) with its connectivity kept and with crack-aware
-families (:class:`~skfem_pg.formulations.CrackAware`: failed cells are
-removed, the families, shape functions and VC correction rebuilt on the
-rest, so nothing connects the broken parts); and FE Q1 with the same law
-at its Gauss points (a cell whose points fail is eroded).  The Unl bases
-take the VC boundary variant ``sn`` (normal component of the correction
-fixed at surface particles, the thesis' option): with the minimum-norm
-variant the corrections of the families along a fresh crack grow, and
-the stable step fell from 1.1e-7 to 7e-10 s within 0.1 ms of the first
-failure (``sn``: 5.6e-8 s).
+U1SIG`` (connectivity kept across the crack, as in the thesis) and U1SIG
+with crack-aware families (:class:`~skfem_pg.formulations.
+CrackAwareU1SIG`: failed cells are removed, the families, shape
+functions and VC correction rebuilt on the rest, so nothing connects the
+broken parts); PG Unl (``VCBCPBG V5sn Unl``) with its connectivity kept
+and crack-aware (:class:`~skfem_pg.formulations.CrackAware`); and FE Q1
+with the same law at its Gauss points (a cell whose points fail is
+eroded).  The crack-aware bases take the VC boundary variant ``sn``
+(normal component of the correction fixed at surface particles, the
+thesis' option), and so does Unl with its connectivity kept, for the
+comparison: with the minimum-norm variant the corrections of the
+families along a fresh crack grow, and the stable step fell within 0.1
+ms of the first failure from 1.1e-7 to 7e-10 s (Unl) and to 2.7e-9 s
+(U1SIG) (``sn``: 5.6e-8 and 4.5e-8 s).
 Prints, per model, when the first point fails and where, the peak bottom
 force and stored energy and when they fall, the failed share, the energy
 balance and the run time.  Writes ``out/two_hole_plate.png`` (damage on
@@ -46,7 +49,8 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.discretization.elementwise import Elements
-from skfem_pg.formulations import CrackAware, Hyperelastic, model_for
+from skfem_pg.formulations import (CrackAware, CrackAwareU1SIG, Hyperelastic,
+                                   model_for)
 from skfem_pg.io import VTUSeries, step_writer
 from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
                                 JohnsonCookHardening)
@@ -60,15 +64,15 @@ RHO = 7.83e-9  # t/mm^3
 SPEED = 2000.0  # mm/s
 #: the suffix of a method whose families stop at the crack
 CRACK_AWARE = "crack-aware"
-METHODS = ("VCPBG V3m U1SIG", "VCBCPBG V5sn Unl",
-           "VCBCPBG V5sn Unl " + CRACK_AWARE, "FEM Q1")
+METHODS = ("VCPBG V3m U1SIG", "VCPBG V3sn U1SIG " + CRACK_AWARE,
+           "VCBCPBG V5sn Unl", "VCBCPBG V5sn Unl " + CRACK_AWARE, "FEM Q1")
 
 
 def setup(mesh, method):
     """``(basis, model)`` of ``method`` on ``mesh``: a Table 7.1 name
-    (connectivity kept), the same followed by ``crack-aware``
-    (:class:`~skfem_pg.formulations.CrackAware`, Unl only) or ``FEM
-    Q1``."""
+    (connectivity kept), the same followed by ``crack-aware`` (Unl:
+    :class:`~skfem_pg.formulations.CrackAware`, U1SIG:
+    :class:`~skfem_pg.formulations.CrackAwareU1SIG`) or ``FEM Q1``."""
     if method.startswith("FEM"):
         basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
         return basis, Hyperelastic(basis, STEEL)
@@ -79,7 +83,9 @@ def setup(mesh, method):
     # the plots and the VTU take a particle's value as its vertex's
     assert np.array_equal(basis.particles.x, mesh.p)
     if aware:
-        return basis, CrackAware(basis, STEEL)
+        u1sig = name.split()[-1] == "U1SIG"
+        return basis, (CrackAwareU1SIG if u1sig else CrackAware)(basis,
+                                                                 STEEL)
     return basis, model_for(name.split()[-1], basis, STEEL)
 
 
@@ -91,14 +97,13 @@ def damage_per_node(model, basis, mesh):
     if failed is None:
         return np.zeros(mesh.nvertices)
     if hasattr(basis, "particles"):
-        if failed.size == basis.particles.n:
-            return failed.astype(float)
         E = Elements(model.point_basis)
         # per family; a particle in no family (all its cells failed,
         # crack-aware) counts as failed
         D = np.ones(mesh.nvertices)
-        D[model.point_basis.families.masters] = \
-            E.sum(failed.astype(float)) / E.volumes
+        D[model.point_basis.families.masters] = (
+            failed.astype(float) if failed.ndim == 1  # masters (U1SIG)
+            else E.sum(failed.astype(float)) / E.volumes)
         return D
     cells = failed.mean(axis=1)
     corners = mesh.t.shape[0]
@@ -176,7 +181,7 @@ def report(r):
           "balance {:.2e}".format(c[-1, 3], last.get("dissipation", np.nan),
                                   last["relative_error"]))
     m = r["model"]
-    if isinstance(m, CrackAware):
+    if isinstance(m, (CrackAware, CrackAwareU1SIG)):
         log = m.update_log
         print("  crack-aware: {} updates ({} cells failed), {:.1f} s in "
               "them ({:.1f} s VC solves), {:.0f} % of the run; {} "
@@ -184,7 +189,7 @@ def report(r):
                   m.updates, sum(e["cells"] for e in log), m.update_seconds,
                   sum(e["vc"] for e in log),
                   100 * m.update_seconds / r["seconds"],
-                  int((~m.current.particles.active).sum())))
+                  int((~m.point_basis.particles.active).sum())))
 
 
 def plot(results, mesh, fn):

@@ -182,12 +182,13 @@ def _taylor(out):
 def _two_hole_plate(out):
     balances = [float(v) for v in re.findall(r"energy balance ([-+\d.e]+)",
                                              out)]
-    # U1SIG, Unl, Unl crack-aware, FE Q1
-    assert len(balances) == 4 and max(abs(b) for b in balances) <= 1e-2
+    # U1SIG kept and crack-aware, Unl kept and crack-aware, FE Q1
+    assert len(balances) == 5 and max(abs(b) for b in balances) <= 1e-2
     assert "first failure at t" in out  # the quick run already fails
-    # and cells fail: the crack-aware families are rebuilt (measured: 3)
-    (updates,) = re.findall(r"crack-aware: (\d+) updates", out)
-    assert int(updates) >= 1
+    # and Unl's cells fail: its crack-aware families are rebuilt
+    # (measured: 3 updates; U1SIG's first master fails at 0.28 ms)
+    updates = re.findall(r"crack-aware: (\d+) updates", out)
+    assert len(updates) == 2 and int(updates[1]) >= 1
 
 
 def _kalthoff_winkler(out):

@@ -83,7 +83,10 @@ def particle_damage(model, basis):
         return np.zeros(basis.particles.n if hasattr(basis, "particles")
                         else basis.mesh.t.shape[1])
     E = Elements(model.point_basis)
-    share = E.sum(failed.astype(float)) / E.volumes
+    if failed.ndim == 1:  # one point per family, its master's (U1SIG)
+        share = failed.astype(float)
+    else:
+        share = E.sum(failed.astype(float)) / E.volumes
     if not hasattr(basis, "particles"):
         return share
     # per particle (a crack-aware model's inactive particles: 1, broken)

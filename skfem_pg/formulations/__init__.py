@@ -32,9 +32,9 @@ What a driver asks of a model is :class:`~.protocol.Model`
 ``bond_based``         :class:`BondBased`: bond-based peridynamics with
                        critical-stretch breaking (PMB), the classical
                        comparator on the same particles and drivers
-``crack_aware``        :class:`CrackAware`: the displacement formulation
-                       whose families stop at failed cells (beyond the
-                       thesis' 8.1)
+``crack_aware``        :class:`CrackAware`, :class:`CrackAwareU1SIG`: Unl
+                       and U1SIG whose families stop at failed cells
+                       (beyond the thesis' 8.1)
 =====================  ====================================================
 """
 from .linear import linear_elasticity
@@ -50,7 +50,7 @@ from .tangents import fd_tangent
 from .history import History
 from .updated_lagrange import UpdatedLagrange
 from .bond_based import BondBased, segment_cut
-from .crack_aware import CrackAware
+from .crack_aware import CrackAware, CrackAwareU1SIG
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
@@ -58,4 +58,4 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
            "History", "UpdatedLagrange", "Model", "BondBased",
-           "segment_cut", "CrackAware"]
+           "segment_cut", "CrackAware", "CrackAwareU1SIG"]

@@ -82,17 +82,20 @@ from ..discretization.elementwise import Elements
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
 from ..threads import kernel
+from ..discretization.shape.least_squares import mls1_master_hessians
 from .displacement import Hyperelastic, internal_force, material_tangent
 from .history import History
+from .stabilized import U1SIG, second_moment
 from .updated_lagrange import carry_points, point_keys
 
 
-def cell_failure(basis, cells, failed):
+def cell_failure(basis, cells, failed, keys=None):
     """The failed share of the integration points each cell holds: points
     :math:`(k, j)` of ``basis`` with master ``k`` and member ``j`` both
     vertices of the cell (``cells``: ``(n_vertices, n_cells)``);
-    ``failed``: per flat point of ``basis``."""
-    keys = point_keys(basis)
+    ``failed``: per flat point of ``basis``, or per point of ``keys``
+    (:math:`k n + j`; U1SIG: its masters, :math:`k n + k`)."""
+    keys = point_keys(basis) if keys is None else np.asarray(keys)
     order = np.argsort(keys)
     sk = keys[order]
     n = basis.particles.n
@@ -204,7 +207,7 @@ class _CrackHistory(History):
                  if k.startswith("crack_")}
         if crack:
             self._model._restore(crack)
-        n = self._model.current.flat_weights().shape[-1]
+        n = self._model._n_points()
         for k, v in saved.items():
             if np.shape(v)[-1] != n:
                 raise ValueError("history {!r} at {} points, the rebuilt "
@@ -213,73 +216,65 @@ class _CrackHistory(History):
         super().restore(saved or None)
 
 
-class CrackAware(Hyperelastic):
-    """The displacement formulation whose families stop at failed cells
-    (module docstring) on ``basis`` (a PBG :class:`~skfem_pg.FamilyBasis`
-    collocated from a mesh's vertices with the ``"mesh"`` family rule) with
-    ``material``, a :class:`~skfem_pg.materials.J2Plasticity` with a damage
-    law.
+def _check_crack_inputs(basis, material, fraction, what):
+    """Named errors for what crack-aware families cannot take."""
+    p = basis.particles
+    if p.kind != "vertices" or p.mesh is None:
+        raise ValueError("crack-aware families remove failed cells of "
+                         "the collocation mesh: the particles must be "
+                         "a mesh's vertices (Particles.from_mesh)")
+    if basis.options.get("families") != "mesh":
+        raise ValueError(
+            "crack-aware families rebuild the families from the intact "
+            "cells: the basis needs the 'mesh' family rule, got {!r}"
+            .format(basis.spec.families))
+    damage = getattr(material, "damage", None)
+    if not getattr(material, "stateful", False) or damage is None:
+        raise ValueError("{!r} has no damage law: nothing can fail "
+                         "(J2Plasticity(..., damage=JohnsonCookDamage"
+                         "(...)))".format(material))
+    if not 0.0 < float(fraction) <= 1.0:
+        raise ValueError("fraction must be in (0, 1], got {!r}".format(
+            fraction))
 
-    ``fraction``: the failed share of its points at which a cell fails;
-    ``min_piece``: pieces cut off with fewer vertices fail whole (default
-    ``dim + 2``, the smallest family a VC-corrected basis takes).
 
-    ``model.basis`` stays the basis of the whole body (dofs, loads,
-    Dirichlet boundaries); ``model.current`` is the basis on the intact
-    cells, ``model.intact`` the mask of the mesh's intact cells.
-    ``updates``, ``update_seconds`` and ``update_log`` (per update: the
-    cells failed and the seconds) say how often the families were rebuilt
-    and what it cost."""
+class _Crack:
+    """What the crack-aware models share (module docstring): the intact
+    cells, when they fail, the update's bookkeeping, checkpoints.  A model
+    adds :meth:`_keys` (its points as :math:`k n + j`), :meth:`_carry`
+    (the history and :math:`F_c` onto a new basis), :meth:`_set_basis`
+    and :meth:`_n_points`."""
 
-    def __init__(self, basis, material, fraction=0.5, min_piece=None):
-        if not isinstance(basis, FamilyBasis) or basis.is_petrov:
-            raise ValueError("crack-aware families are built for PBG family "
-                             "bases, got {}".format(type(basis).__name__))
-        p = basis.particles
-        if p.kind != "vertices" or p.mesh is None:
-            raise ValueError("crack-aware families remove failed cells of "
-                             "the collocation mesh: the particles must be "
-                             "a mesh's vertices (Particles.from_mesh)")
-        if basis.options.get("families") != "mesh":
-            raise ValueError(
-                "crack-aware families rebuild the families from the intact "
-                "cells: the basis needs the 'mesh' family rule, got {!r}"
-                .format(basis.spec.families))
-        damage = getattr(material, "damage", None)
-        if not getattr(material, "stateful", False) or damage is None:
-            raise ValueError("{!r} has no damage law: nothing can fail "
-                             "(J2Plasticity(..., damage=JohnsonCookDamage"
-                             "(...)))".format(material))
-        if not 0.0 < float(fraction) <= 1.0:
-            raise ValueError("fraction must be in (0, 1], got {!r}".format(
-                fraction))
-        super().__init__(basis, material)
-        self.material = _CrackHistory(material, self)
+    def _init_crack(self, particles, fraction, min_piece):
+        self.material = _CrackHistory(self.material.material, self)
         self.fraction = float(fraction)
-        d = p.dim
+        d = particles.dim
         self.min_piece = d + 2 if min_piece is None else int(min_piece)
         if self.min_piece < d + 1:
             raise ValueError("min_piece must be at least dim + 1 = {}, got "
                              "{}".format(d + 1, min_piece))
-        mesh = p.mesh
+        mesh = particles.mesh
         self.intact = np.zeros(mesh.t.shape[1], dtype=bool)
-        self.intact[np.arange(mesh.t.shape[1]) if p.elements is None
-                    else p.elements] = True
-        self.current = basis
-        self.u_c = np.zeros(basis.N)
+        self.intact[np.arange(mesh.t.shape[1]) if particles.elements is None
+                    else particles.elements] = True
+        self.u_c = np.zeros(self.N)
         self.F_c = None  # the identity until the first update
         self.released_at_updates = 0.0
         self.updates, self.update_seconds, self.update_log = 0, 0.0, []
         self._n_failed = 0
 
+    @property
+    def _mesh(self):
+        return self.basis.particles.mesh
+
     # -- the crack ------------------------------------------------------
     def cells_to_fail(self, failed):
-        """The intact cells that fail with the points ``failed`` (per flat
-        point of :attr:`current`), debris included (module
-        docstring)."""
-        mesh = self.basis.particles.mesh
+        """The intact cells that fail with the points ``failed`` (per
+        point of the history), debris included (module docstring)."""
+        mesh = self._mesh
         idx = np.flatnonzero(self.intact)
-        share = cell_failure(self.current, mesh.t[:, idx], failed)
+        share = cell_failure(self.basis, mesh.t[:, idx], failed,
+                             self._keys())
         fail = np.zeros_like(self.intact)
         fail[idx[share >= self.fraction - 1e-12]] = True
         if not fail.any():
@@ -287,27 +282,30 @@ class CrackAware(Hyperelastic):
         return self.intact & ~separate(mesh, self.intact & ~fail,
                                        self.min_piece)
 
+    def _basis_on(self, intact):
+        """The basis of the model's options on the intact cells."""
+        particles = Particles.from_mesh(self._mesh,
+                                        elements=np.flatnonzero(intact))
+        return FamilyBasis(particles, **self._options)
+
     def update(self, u, F, fail):
-        """Fail the cells ``fail`` at the displacements ``u`` (the
-        committed point gradients ``F`` on :attr:`current`): collocate,
-        rebuild, carry :math:`F` and the history over and book the
-        released energy."""
+        """Fail the cells ``fail`` at the displacements ``u`` (``F``: the
+        committed gradients at the history's points): collocate, rebuild,
+        carry :math:`F` and the history over and book the released
+        energy."""
         t0 = time.perf_counter()
-        mesh = self.basis.particles.mesh
         intact = self.intact & ~fail
         if not intact.any():
             raise FamilyError("every cell of the collocation mesh has "
                               "failed: nothing is left to build families on")
-        before = self._stored_and_released(F)
-        particles = Particles.from_mesh(mesh,
-                                        elements=np.flatnonzero(intact))
-        new = FamilyBasis(particles, **self.basis.options)
+        u = np.array(u[:self.N], dtype=float)
+        before = self._stored_and_released(u)
+        new = self._basis_on(intact)
         self._check_pieces(new, intact)
-        F_new = carry_points(self.history, self.current, new, F)
-        self.current, self.intact = new, intact
-        self.F_c, self.u_c = F_new, np.array(u[:self.n_u], dtype=float)
-        after = self._stored_and_released(F_new)
-        self.released_at_updates += before - after
+        self.F_c = self._carry(new, np.asarray(F))
+        self._set_basis(new)
+        self.intact, self.u_c = intact, u
+        self.released_at_updates += before - self._stored_and_released(u)
         self.updates += 1
         seconds = time.perf_counter() - t0
         self.update_seconds += seconds
@@ -316,21 +314,18 @@ class CrackAware(Hyperelastic):
                                 "vc": float(new.timings.get("vc", 0.0))})
         return new
 
-    def _stored_and_released(self, F):
-        """:math:`\\sum w\\, (W(F) + \\text{released})` on :attr:`current`
+    def _stored_and_released(self, u):
+        """The stored energy at ``u`` plus what the failed points released
         (the energy an update must account for)."""
-        stored = float(np.sum(self.current.flat_weights()
-                              * self.material.energy(F)))
-        r = self.history.released()
-        return stored + (0.0 if r is None else
-                         float(Elements(self.current).sum(r).sum()))
+        r = super().fracture_energy()
+        return self.energy(self.state(u)) + (0.0 if r is None else r)
 
     def _check_pieces(self, new, intact):
         """No family may reach across a failed cell into another piece
         (the mesh rule enlarges a small family ring by ring, then by its
         nearest particles): raise :class:`FamilyError` naming the first
         master whose family does."""
-        mesh = self.basis.particles.mesh
+        mesh = self._mesh
         cells = np.flatnonzero(intact)
         label, _ = pieces(mesh, intact)
         vertex = np.full(mesh.p.shape[1], -1)
@@ -349,11 +344,9 @@ class CrackAware(Hyperelastic):
     def _restore(self, crack):
         """Rebuild the basis on a checkpoint's intact cells."""
         intact = np.asarray(crack["crack_intact"]) > 0.5
-        self.intact = intact
         if self.updates or not intact.all():
-            particles = Particles.from_mesh(
-                self.basis.particles.mesh, elements=np.flatnonzero(intact))
-            self.current = FamilyBasis(particles, **self.basis.options)
+            self._set_basis(self._basis_on(intact))
+        self.intact = intact
         self.u_c = np.asarray(crack["crack_u_c"], dtype=float)
         F = crack.get("crack_F_c")
         self.F_c = None if F is None else np.asarray(F, dtype=float)
@@ -377,19 +370,62 @@ class CrackAware(Hyperelastic):
         fail = self.cells_to_fail(failed)
         if not fail.any():
             return False
-        self.update(state["u"], np.array(state["F"]), fail)
+        self.update(state["u"], np.array(state[self._gradient_key]), fail)
         self._n_failed = int(self.history.failed().sum())
         return True
-
-    @property
-    def point_basis(self):
-        """The basis on the intact cells: its points carry the history."""
-        return self.current
 
     def fracture_energy(self):
         """What the failed points released, plus what the updates released
         (module docstring)."""
         return super().fracture_energy() + self.released_at_updates
+
+
+class CrackAware(_Crack, Hyperelastic):
+    """The displacement formulation whose families stop at failed cells
+    (module docstring) on ``basis`` (a PBG :class:`~skfem_pg.FamilyBasis`
+    collocated from a mesh's vertices with the ``"mesh"`` family rule) with
+    ``material``, a :class:`~skfem_pg.materials.J2Plasticity` with a damage
+    law.
+
+    ``fraction``: the failed share of its points at which a cell fails;
+    ``min_piece``: pieces cut off with fewer vertices fail whole (default
+    ``dim + 2``, the smallest family a VC-corrected basis takes).
+
+    ``model.basis`` stays the basis of the whole body (dofs, loads,
+    Dirichlet boundaries); ``model.current`` is the basis on the intact
+    cells, ``model.intact`` the mask of the mesh's intact cells.
+    ``updates``, ``update_seconds`` and ``update_log`` (per update: the
+    cells failed and the seconds) say how often the families were rebuilt
+    and what it cost."""
+
+    _gradient_key = "F"
+
+    def __init__(self, basis, material, fraction=0.5, min_piece=None):
+        if not isinstance(basis, FamilyBasis) or basis.is_petrov:
+            raise ValueError("crack-aware families are built for PBG family "
+                             "bases, got {}".format(type(basis).__name__))
+        _check_crack_inputs(basis, material, fraction, "Unl")
+        super().__init__(basis, material)
+        self.current = basis
+        self._options = basis.options
+        self._init_crack(basis.particles, fraction, min_piece)
+
+    def _keys(self):
+        return point_keys(self.current)
+
+    def _carry(self, new, F):
+        return carry_points(self.history, self.current, new, F)
+
+    def _set_basis(self, new):
+        self.current = new
+
+    def _n_points(self):
+        return self.current.flat_weights().shape[-1]
+
+    @property
+    def point_basis(self):
+        """The basis on the intact cells: its points carry the history."""
+        return self.current
 
     @kernel
     def state(self, u):
@@ -411,3 +447,86 @@ class CrackAware(Hyperelastic):
     def tangent(self, state):
         return assemble(material_tangent, self.current,
                         A=self.material.tangent(state["F"]))
+
+
+class CrackAwareU1SIG(_Crack, U1SIG):
+    r"""U1SIG (:class:`~skfem_pg.formulations.U1SIG`, the thesis' fracture
+    formulation) with crack-aware families (module docstring): the
+    material and its history at the masters, a cell fails when
+    ``fraction`` of its vertices' masters have failed.  After an update
+    the master gradients are :math:`F^{kk} = F^{kk}_c + \sum_i (u^i -
+    u^i_c) \otimes G^{kki}` and the implicit-gradient stabilization acts
+    on :math:`u - u_c` [choice made here: the stabilization's accumulated
+    force is dropped at an update, its energy booked as released, as the
+    stabilization only controls the zero-energy modes of the new
+    families]."""
+
+    _gradient_key = "F1"
+
+    def __init__(self, basis, material, fraction=0.5, min_piece=None):
+        if not isinstance(basis, FamilyBasis) or basis.is_petrov:
+            raise ValueError("crack-aware families are built for PBG family "
+                             "bases, got {}".format(type(basis).__name__))
+        _check_crack_inputs(basis, material, fraction, "U1SIG")
+        super().__init__(basis, material)
+        self._options = self.u1.options
+        self._init_crack(basis.particles, fraction, min_piece)
+
+    @classmethod
+    def of(cls, basis, material):
+        return cls(basis, material)
+
+    def _keys(self):
+        m = self.u1.families.masters
+        return m * self.u1.particles.n + m
+
+    def _carry(self, new, F1):
+        """The masters' history and :math:`F^{kk}` on ``new`` (whose
+        masters are a subset of the current ones)."""
+        where = np.full(self.u1.particles.n, -1)
+        where[self.u1.families.masters] = np.arange(
+            len(self.u1.families.masters))
+        idx = where[new.families.masters]
+        h = self.history
+        if h.committed is not None:
+            h.committed = {k: v[..., idx] for k, v in h.committed.items()}
+            h._last = None
+        if self._F_committed is not None:
+            self._F_committed = self._F_committed[..., idx]
+        return F1[..., idx]
+
+    def _set_basis(self, new):
+        """Everything U1SIG derives from its basis, on ``new``."""
+        p, fam = new.particles, new.families
+        self.u1 = new
+        self._E1 = Elements(new)
+        self._master_flat = fam.offsets[:-1]
+        self._G0 = None
+        self.hessians = mls1_master_hessians(p.x, p.volumes, fam,
+                                             n=new.weight_exponent)
+        self.M2 = second_moment(p.volumes[fam.masters], p.dim)
+        self._Ks, self._At, self._frozen = (None, None), (None, None), \
+            (None, None)
+
+    def _n_points(self):
+        return len(self.u1.families.masters)
+
+    @property
+    def point_basis(self):
+        """The basis on the intact cells (its masters carry the
+        history)."""
+        return self.u1
+
+    def master_F(self, u):
+        F = super().master_F(np.asarray(u, dtype=float) - self.u_c)
+        return F if self.F_c is None else F - self._eye[:, :, :, 0] \
+            + self.F_c
+
+    def stabilization_force(self, u):
+        return super().stabilization_force(np.asarray(u, dtype=float)
+                                           - self.u_c)
+
+    def energy(self, state):
+        du = state["u"] - self.u_c
+        return (self._master_energy(self.material.energy(state["F1"]))
+                + 0.5 * float(du @ self.stabilization_force(state["u"])))
