@@ -81,8 +81,8 @@ class CriticalStrainDamage:
     tensor :math:`b_e^{tr}` (the elastic strain where the point does not
     yield) reaches ``critical_strain``,
 
-    .. math:: D = \max_{steps} rac{	frac12 \ln \lambda_{max}
-              (b_e^{tr})}{arepsilon_c}, \qquad 	ext{failure at }
+    .. math:: D = \max_{steps} \frac{\tfrac12 \ln \lambda_{max}
+              (b_e^{tr})}{\varepsilon_c}, \qquad \text{failure at }
               D \ge D_c = 1,
 
     the continuum counterpart of the bond-based model's critical stretch
@@ -91,7 +91,7 @@ class CriticalStrainDamage:
     :class:`~skfem_pg.materials.J2Plasticity`'s (no deviatoric stress, no
     tension).  For a fracture energy :math:`G_0` and a crack one particle
     spacing :math:`h` wide, :meth:`from_fracture_energy` gives
-    :math:`arepsilon_c = \sqrt{2 G_0 / (E h)}` (the energy of a linear
+    :math:`\varepsilon_c = \sqrt{2 G_0 / (E h)}` (the energy of a linear
     elastic band of width h strained to failure equals :math:`G_0` per
     unit crack area) [crack-band scaling, a choice].
 
@@ -129,7 +129,7 @@ class CriticalStrainDamage:
         return np.zeros(np.shape(dalpha))
 
     def indicator(self, b):
-        r""":math:`	frac12\ln\lambda_{max}(b) / arepsilon_c` of
+        r""":math:`\tfrac12\ln\lambda_{max}(b) / \varepsilon_c` of
         symmetric ``b`` ``(n, 3, 3)``."""
         lam = np.linalg.eigvalsh(b)[:, -1]
         return 0.5 * np.log(lam) / self.critical_strain
