@@ -261,3 +261,25 @@ def test_explicit_updated_lagrange_follows_total_lagrange():
         out[name] = np.array(us)
     assert model.updates > 5
     assert np.abs(out["UL"] - out["TL"]).max() < 2e-4 * 0.05  # 1.7e-5
+
+
+def test_lanczos_estimate_equals_the_dense_eigenvalue():
+    """The stable-step estimate (Lanczos, full reorthogonalization) against
+    the dense largest eigenvalue of M^-1/2 K M^-1/2, cold and warm
+    started (from a Ritz vector, as central_difference does)."""
+    from skfem_pg.solvers.explicit import lanczos_max
+    from skfem_pg.solvers.exchange import SerialExchange
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((300, 300))
+    A = A @ A.T + np.diag(np.linspace(0, 50, 300))
+    lam = np.linalg.eigvalsh(A)[-1]
+    ex = SerialExchange(300)
+    th, ritz, its = lanczos_max(lambda x: A @ x, ex.start_vector(), ex,
+                                tol=1e-6)
+    assert abs(th - lam) <= 1e-9 * lam
+    th2, _, its2 = lanczos_max(lambda x: A @ x, ritz + 0.1 * ex.start_vector()
+                               / 17.3, ex, tol=1e-6)
+    assert abs(th2 - lam) <= 1e-9 * lam and its2 < its
+    with pytest.raises(RuntimeError, match="did not converge"):
+        lanczos_max(lambda x: A @ x, ex.start_vector(), ex, tol=1e-14,
+                    maxiter=3)

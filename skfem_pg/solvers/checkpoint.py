@@ -92,6 +92,13 @@ def save(path, model, x, load=1.0, **state):
         arrays["history_" + k] = v
     for k, v in state.items():
         arrays["state_" + k] = v
+    return atomic_savez(path, **arrays)
+
+
+def atomic_savez(path, **arrays):
+    """``numpy.savez`` to ``path`` atomically: a temporary file in the
+    same directory, flushed to disk, then ``os.replace``."""
+    path = _path(path)
     d = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(dir=d, prefix=".checkpoint-",
                                suffix=".tmp.npz")
@@ -189,16 +196,25 @@ class Every:
             return spec
         return cls(spec)
 
-    def save(self, count, model, x, load, **state):
-        """:func:`save` if due at converged step number ``count``."""
+    def due(self, count):
+        """Whether a checkpoint is due at converged step number
+        ``count``."""
         now = time.monotonic()
         if self._last_time is None:
             self._last_time = now
-        due = (self.steps is None and self.seconds is None) or (
+        return (self.steps is None and self.seconds is None) or (
             self.steps is not None and count - self._last_step >= self.steps
         ) or (self.seconds is not None
               and now - self._last_time >= self.seconds)
+
+    def write(self, count, model, x, load, **state):
+        """Write the checkpoint (:func:`save`)."""
+        save(self.path, model, x, load, **state)
+
+    def save(self, count, model, x, load, **state):
+        """:func:`save` if due at converged step number ``count``."""
+        due = self.due(count)
         if due:
-            save(self.path, model, x, load, **state)
-            self._last_step, self._last_time = count, now
+            self.write(count, model, x, load, **state)
+            self._last_step, self._last_time = count, time.monotonic()
         return due

@@ -95,10 +95,11 @@ class RigidWall:
         return self.side * force > 0
 
 
-def hold_initial(walls, candidates, u, v, a, m, held):
+def hold_initial(walls, candidates, u, v, a, m, held, dot=None):
     """Hold the candidates that start on a wall moving or pushed into it
     (zero normal velocity and acceleration); returns the kinetic energy
-    the walls took.  A body that starts behind a wall (displaced there by
+    the walls took (``dot``: the sum over dofs, of all ranks on MPI).
+    A body that starts behind a wall (displaced there by
     ``u0``) is refused by name."""
     lost = 0.0
     for w, c in zip(walls, candidates):
@@ -114,6 +115,7 @@ def hold_initial(walls, candidates, u, v, a, m, held):
         into = w.side * (v[c] + a[c]) < 0
         h = c[on & into]
         held[h] = True
-        lost += 0.5 * float(np.dot(m[h], v[h] ** 2))
+        lost += 0.5 * (float(np.dot(m[h], v[h] ** 2)) if dot is None
+                       else dot(m, v * v, h))
         v[h], a[h] = 0.0, 0.0
     return lost

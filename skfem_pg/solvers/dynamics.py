@@ -103,8 +103,11 @@ def check_run(n_u, N, m, t_end, dt=None, u0=None, v0=None,
 class EnergyBalance:
     """The energies of a run (module docstring), updated per step."""
 
-    def __init__(self, m, v0, free, stored0=None):
+    def __init__(self, m, v0, free, stored0=None, dot=None):
         self.m = m
+        # sums over dofs: the serial dot product, or one over the owned
+        # dofs of all ranks (HaloExchange.dot)
+        self.dot = _dot if dot is None else dot
         self.T0 = self.kinetic(v0, free)
         self.W_int = self.W_ext = self.W_D = self.D_c = 0.0
         # the energy scale of the relative error: the largest energy met
@@ -114,7 +117,7 @@ class EnergyBalance:
     def kinetic(self, v, free):
         n = self.m.shape[0]
         vf = np.where(free, v[:n], 0.0)
-        return 0.5 * float(np.dot(self.m, vf * vf))
+        return 0.5 * self.dot(self.m, vf * vf)
 
     def step(self, du, fi0, fi1, fe0, fe1, D, held=None, v0=None, v1=None,
              free0=None, free1=None):
@@ -125,17 +128,16 @@ class EnergyBalance:
         n = self.m.shape[0]
         du = du[:n]
         fi, fe = 0.5 * (fi0[:n] + fi1[:n]), 0.5 * (fe0[:n] + fe1[:n])
-        self.W_int += float(np.dot(fi, du))
-        self.W_ext += float(np.dot(fe, du))
-        self.W_D += float(np.dot(fi[D] - fe[D], du[D]))
+        self.W_int += self.dot(fi, du)
+        self.W_ext += self.dot(fe, du)
+        self.W_D += self.dot(fi - fe, du, D)
         if held is not None and held.size:
-            m = self.m[held]
-            k0 = np.where(free0[held], v0[held] ** 2, 0.0)
-            k1 = np.where(free1[held], v1[held] ** 2, 0.0)
+            k0 = np.where(free0, v0[:n] ** 2, 0.0)
+            k1 = np.where(free1, v1[:n] ** 2, 0.0)
             # work of the contact force on the held dofs = their kinetic
             # change + their internal minus external work
-            w = 0.5 * np.dot(m, k1 - k0) + np.dot(fi[held] - fe[held],
-                                                   du[held])
+            w = 0.5 * self.dot(self.m, k1 - k0, held) + self.dot(
+                fi - fe, du, held)
             self.D_c -= float(w)
 
     #: the accounts a checkpoint keeps
@@ -166,6 +168,12 @@ class EnergyBalance:
             out["stored"] = stored
             out["dissipation"] = self.W_int - stored
         return out
+
+
+def _dot(a, b, idx=None):
+    if idx is None:
+        return float(np.dot(a, b))
+    return float(np.dot(a[idx], b[idx]))
 
 
 class DynamicsError(RuntimeError):
@@ -316,19 +324,22 @@ class Recorder:
     ``callback(t, x, v, record)`` and the seconds spent (``times
     ["output"]``).  ``hist`` holds the records."""
 
-    def __init__(self, model, energy, free, progress, callback, times):
+    def __init__(self, model, energy, free, progress, callback, times,
+                 total=None):
         self.model, self.energy, self.free = model, energy, free
         self.progress, self.callback, self.times = progress, callback, times
+        # a model's energies summed over the ranks (HaloExchange.sum)
+        self.total = (lambda x: x) if total is None else total
         self.hist = []
 
     def __call__(self, t, x, v, state, held, final=False, **data):
         """Record the state at ``t``; ``data``: ``dt``, ``steps`` and what
         else the integrator reports (in the record's order)."""
         t1 = time.perf_counter()
-        rec = self.energy.record(t, v, self.free & ~held,
-                                 stored_energy(self.model, state))
+        rec = self.energy.record(t, v, self.free & ~held, self.total(
+            stored_energy(self.model, state)))
         fracture = getattr(self.model, "fracture_energy", None)
-        fracture = None if fracture is None else fracture()
+        fracture = None if fracture is None else self.total(fracture())
         if fracture is not None:
             # part of the dissipation: what failed points or broken bonds
             # had stored when they failed

@@ -24,8 +24,8 @@ Stable step (not in the thesis, which cites the CFL condition):
 the material held elastic (:meth:`History.elastic_predictor
 <skfem_pg.formulations.history.History.elastic_predictor>`: the plastic
 tangent is softer than elastic unloading, which sets the limit),
-by Lanczos iterations (``scipy.sparse.linalg.eigsh``) on
-:math:`M^{-1/2} K M^{-1/2}`.  As the configuration changes the step is
+by Lanczos iterations (:func:`lanczos_max`, each estimate started from
+the previous one's Ritz vector) on :math:`M^{-1/2} K M^{-1/2}`.  As the configuration changes the step is
 divided by :func:`compression_since` the last estimate (how much the most
 compressed point shrank since), and estimated again every
 ``estimate_every`` steps or as soon as that factor exceeds
@@ -40,9 +40,7 @@ from typing import Callable
 import time
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike
-from scipy.sparse.linalg import eigsh
 
 from ..formulations.protocol import Model
 from ..dofs import as_dofs
@@ -50,6 +48,7 @@ from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
 from .checkpoint import Every
+from .exchange import SerialExchange
 from .controls import ExplicitControls
 from .dynamics import (DynamicsError, EnergyBalance, MAX_STEPS, Progress,
                        Recorder, Trajectory, bind_walls, check_run, commit,
@@ -63,6 +62,11 @@ from ..discretization.particles import inverted_cells
 #: the first steps (8 % at step 1, 0.4 % at step 10 in the wave-arrival
 #: test) and then settles; an unstable step grows without bound
 STARTUP_STEPS = 10
+
+
+#: the share of the start vector mixed into the previous estimate's Ritz
+#: vector when a stable-step estimate starts from it (warm start)
+WARM_MIX = 0.1
 
 
 #: a stable-step estimate is repeated at once when a point has been
@@ -106,34 +110,89 @@ def _elastic(model):
         contextlib.nullcontext()
 
 
-def max_frequency(model, m, x, free=None, tol=1e-3):
+def max_frequency(model, m, x, free=None, tol=1e-3, exchange=None,
+                  start=None, out=None):
     r""":math:`\omega_{max} = \sqrt{\lambda_{max}(M^{-1}K)}` of the
     tangent at ``x`` on the ``free`` displacement dofs (default all with
     mass), the material held elastic; the symmetric part of a
-    Petrov–Galerkin tangent."""
+    Petrov–Galerkin tangent.  Lanczos iterations (:func:`lanczos_max`,
+    Ritz residual ``tol`` relative) on :math:`M^{-1/2} K M^{-1/2}`;
+    ``exchange`` (default serial) sums the products over MPI ranks,
+    ``start`` is a start vector (default
+    :func:`~skfem_pg.solvers.exchange.start_vector` of the dof numbers),
+    ``out`` a dict that receives the Ritz vector and the iterations."""
+    exchange = SerialExchange(m.shape[0]) if exchange is None else exchange
     n_u = m.shape[0]
     free = m > 0 if free is None else free & (m > 0)
     with _elastic(model):
         K = model.tangent(model.state(x)).tocsr()[:n_u, :n_u]
-    idx = np.flatnonzero(free)
-    s = sp.diags(1.0 / np.sqrt(m[idx]))
-    K = K[idx][:, idx]
-    S = s @ (0.5 * (K + K.T)) @ s
-    if S.shape[0] <= 50:
-        return float(np.sqrt(max(np.linalg.eigvalsh(S.toarray()).max(),
-                                 0.0)))
-    v0 = np.random.default_rng(0).random(S.shape[0]) + 0.5
-    lam = eigsh(S, k=1, which="LA", tol=tol, v0=v0,
-                ncv=min(S.shape[0] - 1, 24), return_eigenvectors=False,
-                maxiter=5000)
-    return float(np.sqrt(max(lam[0], 0.0)))
+    s = np.where(free, 1.0 / np.sqrt(np.where(m > 0, m, 1.0)), 0.0)
+    KT = K.T.tocsr()
+
+    def matvec(y):
+        y = s * y
+        return s * exchange.complete(0.5 * (K @ y + KT @ y))
+
+    v0 = exchange.start_vector() if start is None else start
+    lam, ritz, its = lanczos_max(matvec, np.where(free, v0, 0.0),
+                                 exchange, tol)
+    if out is not None:
+        out.update(ritz=ritz, iterations=its)
+    return float(np.sqrt(max(lam, 0.0)))
 
 
-def stable_time_step(model, m, x=None, free=None, safety=0.8):
+#: most Lanczos iterations of one estimate (it keeps that many vectors)
+LANCZOS_MAXITER = 150
+
+
+def lanczos_max(matvec, v0, exchange, tol=1e-3, maxiter=LANCZOS_MAXITER):
+    r"""The largest eigenvalue of the symmetric operator ``matvec`` by
+    Lanczos iterations from ``v0`` with full reorthogonalization, stopped
+    when the Ritz residual :math:`\beta_j |s_j|` is at most ``tol``
+    times the Ritz value (ARPACK's criterion).  Sums over dofs go through
+    ``exchange.dot`` (all ranks).  Returns ``(theta, ritz_vector,
+    iterations)``; raises ``RuntimeError`` if ``maxiter`` iterations do
+    not converge (a non-symmetric or non-finite operator)."""
+    beta0 = np.sqrt(exchange.dot(v0, v0))
+    if not beta0 > 0:
+        raise ValueError("no free dof with mass: no frequency to estimate")
+    V = [v0 / beta0]
+    alpha, beta = [], []
+    theta, s = 0.0, np.ones(1)
+    for j in range(maxiter):
+        w = matvec(V[-1])
+        a = exchange.dot(V[-1], w)
+        alpha.append(a)
+        # full reorthogonalization, twice (classical Gram–Schmidt)
+        for _ in range(2):
+            for q, ci in zip(V, exchange.dots(V, w)):
+                w -= ci * q
+        b = np.sqrt(exchange.dot(w, w))
+        T = np.diag(alpha) + np.diag(beta, 1) + np.diag(beta, -1)
+        ev, evec = np.linalg.eigh(T)
+        theta, s = ev[-1], evec[:, -1]
+        if not np.isfinite(theta):
+            raise RuntimeError("Lanczos: a non-finite Ritz value at "
+                               "iteration {}".format(j + 1))
+        if b * abs(s[-1]) <= tol * abs(theta) or b <= 1e-14 * abs(theta):
+            break
+        beta.append(b)
+        V.append(w / b)
+    else:
+        raise RuntimeError("Lanczos: the largest eigenvalue did not "
+                           "converge in {} iterations (residual {:.3g} of "
+                           "{:.3g})".format(maxiter, b * abs(s[-1]), theta))
+    ritz = sum(si * q for si, q in zip(s, V))
+    return float(theta), ritz, j + 1
+
+
+def stable_time_step(model, m, x=None, free=None, safety=0.8,
+                     exchange=None, start=None, out=None):
     r"""The central-difference step :math:`s \cdot 2/\omega_{max}`
     (:func:`max_frequency`) at ``x`` (default the initial unknowns)."""
     x = model.initial() if x is None else x
-    w = max_frequency(model, m, x, free)
+    w = max_frequency(model, m, x, free, exchange=exchange, start=start,
+                      out=out)
     if not w > 0:
         raise ValueError("no stiffness on the free dofs (omega_max = {}): "
                          "no stable step".format(w))
@@ -149,7 +208,7 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
                        callback: Callable | None = None, checkpoint=None,
                        resume: str | None = None,
                        controls: ExplicitControls | None = None,
-                       **kw) -> Trajectory:
+                       exchange=None, **kw) -> Trajectory:
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by central differences.
 
@@ -176,6 +235,10 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         ``callback(t, x, v, record)`` at the start, every
         ``output_every`` steps (default: about 20 outputs, guessed from
         the first step) and at the end; ``record``: the energies.
+    exchange
+        The communication between the parts of a model on MPI ranks
+        (the vectors are then a rank's local ones); default serial
+        (:mod:`skfem_pg.solvers.exchange` states what it provides).
     controls, **kw
         :class:`~skfem_pg.solvers.ExplicitControls` (``safety``,
         ``estimate_every``, ``output_every``, ``max_energy_error`` (checked
@@ -209,10 +272,11 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             "explicit steps would need a global solve (6.2.3); integrate "
             "it with newmark".format(type(model).__name__,
                                      model.N - n_u, model.N))
+    ex = SerialExchange(n_u) if exchange is None else exchange
     m = check_run(n_u, n_u, m, t_end, dt, u0, v0)
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     f_of, uD_of = time_functions(model, f_ext, u_D)
-    walls, cand = bind_walls(wall, model.basis, n_u, Dd)
+    walls, cand = _collective(ex, bind_walls, wall, model.basis, n_u, Dd)
     u = model.initial() if u0 is None else np.asarray(u0, float).copy()
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
     if u.shape != (n_u,) or v.shape != (n_u,):
@@ -223,16 +287,19 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
     times = dict.fromkeys(("force", "commit", "estimate", "contact",
                            "output"), 0.0)
     t_start = t0 = time.perf_counter()
-    state = _evaluate(model, u, 0.0, None, v)
-    fi = model.internal_force(state)
+    state = _evaluate(model, u, 0.0, None, v, exchange=ex)
+    fi = ex.complete(model.internal_force(state))
     times["force"] += time.perf_counter() - t0
     fe = f_of(0.0)
     a = inv_m * (fe - fi)
     held = np.zeros(n_u, dtype=bool)  # dofs a wall holds
-    energy = EnergyBalance(m, v, free, stored_energy(model, state))
-    energy.D_c += hold_initial(walls, cand, u, v, a, m, held)
-    progress = Progress(t_end, verbose)
-    out = Recorder(model, energy, free, progress, callback, times)
+    energy = EnergyBalance(m, v, free, ex.sum(stored_energy(model, state)),
+                           dot=ex.dot)
+    energy.D_c += _collective(ex, hold_initial, walls, cand, u, v, a, m,
+                              held, ex.dot)
+    progress = Progress(t_end, verbose if ex.root else False)
+    out = Recorder(model, energy, free, progress, callback, times,
+                   total=ex.sum)
     hist = out.hist
     t, steps = 0.0, 0
 
@@ -242,9 +309,20 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
 
     step = dt
     F_est = None  # the deformation at the last estimate
+    lanczos = {}  # the last estimate's Ritz vector: the next one's start
+
+    def estimate():
+        start = None
+        if "ritz" in lanczos:  # warm start, with all modes present
+            r, sv = lanczos["ritz"], ex.start_vector()
+            start = r / np.sqrt(ex.dot(r, r)) + WARM_MIX * sv / np.sqrt(
+                ex.dot(sv, sv))
+        return stable_time_step(model, m, u, free, safety, exchange=ex,
+                                start=start, out=lanczos)
+
     if step is None:
         t1 = time.perf_counter()
-        step = stable_time_step(model, m, u, free, safety)
+        step = estimate()
         F_est = _gradients(state)
         times["estimate"] += time.perf_counter() - t1
     base = step  # the estimate's step, before the configuration scaling
@@ -258,15 +336,15 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             float(saved["base"])
         output_every = int(saved["output_every"])
         F_est = saved.get("F_est")
-        state = _evaluate(model, u, t, hist, v)
+        state = _evaluate(model, u, t, hist, v, exchange=ex)
         fe = f_of(t)
     every = Every.of(checkpoint)
     while t < t_end * (1 - 1e-12):
         if dt is None and steps:
             t1 = time.perf_counter()
-            ratio = compression_since(F_est, _gradients(state))
+            ratio = ex.max(compression_since(F_est, _gradients(state)))
             if steps % estimate_every == 0 or ratio > REESTIMATE:
-                base = stable_time_step(model, m, u, free, safety)
+                base = estimate()
                 F_est, ratio = _gradients(state), 1.0
             step = base / ratio
             times["estimate"] += time.perf_counter() - t1
@@ -287,13 +365,13 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         _onto_walls(walls, cand, held, u, un, vh, h)
         times["contact"] += time.perf_counter() - t1
         t1 = time.perf_counter()
-        state = _evaluate(model, un, t + h, hist, v, u)
-        fi_n = model.internal_force(state)
+        state = _evaluate(model, un, t + h, hist, v, u, exchange=ex)
+        fi_n = ex.complete(model.internal_force(state))
         t2 = time.perf_counter()
-        if commit(model, state, t + h, u, v, hist):
+        if _collective(ex, commit, model, state, t + h, u, v, hist):
             # the families were rebuilt: the force of the new basis
-            state = _evaluate(model, un, t + h, hist, v, u)
-            fi_n = model.internal_force(state)
+            state = _evaluate(model, un, t + h, hist, v, u, exchange=ex)
+            fi_n = ex.complete(model.internal_force(state))
         times["commit"] += time.perf_counter() - t2
         times["force"] += t2 - t1
         fe_n = f_of(t + h)
@@ -352,20 +430,50 @@ def _hold_on_walls(walls, cand, held, un, vn, a_n, h):
         vn[hc], a_n[hc] = 0.0, 0.0
 
 
-def _evaluate(model, u, t, hist, v, u_last=None):
+def _evaluate(model, u, t, hist, v, u_last=None, exchange=None):
     """``model.state(u)`` with the checks of a step: a return map that
-    fails or an inverted point stops the run with the time."""
+    fails or an inverted point stops the run with the time (on every rank
+    when one rank fails: one reduction of the minimum J)."""
+    ex = SerialExchange(len(u)) if exchange is None else exchange
+    state, failed = None, None
     try:
         state = model.state(u)
+        J = model.min_J(state)
     except ReturnMapError as err:
-        raise DynamicsError("return map failed at t = {:.6g}: {}".format(
-            t, err), t=t, x=u_last, v=v, history=hist) from None
-    J = model.min_J(state)
+        failed, J = "return map failed at t = {:.6g}: {}".format(t, err), \
+            -np.inf
+    except Exception as err:  # noqa: BLE001 - re-raised below
+        if exchange is None:
+            raise
+        failed, J = "{}: {}".format(type(err).__name__, err), -np.inf
+    J = ex.min(J if np.isfinite(J) else -np.inf)
     if not J > 0:
-        raise DynamicsError("an inverted point (min J = {:.3g}) at t = "
-                            "{:.6g}{}".format(J, t, inversion_note(model, u)),
-                            t=t, x=u_last, v=v, history=hist)
+        message = ex.first(failed)
+        if message is None:
+            message = "an inverted point (min J = {:.3g}) at t = {:.6g}{}" \
+                .format(J, t, ex.first(inversion_note(model, u) or None)
+                        or "")
+        raise DynamicsError(message, t=t, x=u_last, v=v, history=hist)
     return state
+
+
+def _collective(exchange, fn, *args):
+    """``fn(*args)``, whose error on one rank is raised on every rank
+    (serial: called as it is)."""
+    if isinstance(exchange, SerialExchange):
+        return fn(*args)
+    failed, out = None, None
+    try:
+        out = fn(*args)
+    except Exception as err:  # noqa: BLE001 - re-raised on every rank
+        failed = err
+    message = exchange.first(None if failed is None else "{}: {}".format(
+        type(failed).__name__, failed))
+    if message is not None:
+        if failed is not None:
+            raise failed
+        raise DynamicsError(message)
+    return out
 
 
 def inversion_note(model, u):
