@@ -131,7 +131,7 @@ class EnergyBalance:
         self.W_int += self.dot(fi, du)
         self.W_ext += self.dot(fe, du)
         self.W_D += self.dot(fi - fe, du, D)
-        if held is not None and held.size:
+        if held is not None:  # on every rank: the sums are collective
             k0 = np.where(free0, v0[:n] ** 2, 0.0)
             k1 = np.where(free1, v1[:n] ** 2, 0.0)
             # work of the contact force on the held dofs = their kinetic

@@ -248,7 +248,8 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
         ``Every("taylor.npz", seconds=600)``) to write the run's state to
         (time, displacements, velocities, accelerations, internal force,
-        held dofs, the step estimate and the deformation it was made at,
+        held dofs, the step estimate, the deformation it was made at and its
+        Ritz vector (the next estimate's start),
         energy accounts, records, the model's history; atomically); a path
         to resume such a run from: it then ends where the uninterrupted
         run ends, to round-off.
@@ -313,7 +314,8 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
 
     def estimate():
         start = None
-        if "ritz" in lanczos:  # warm start, with all modes present
+        if lanczos.get("ritz") is not None and \
+                lanczos["ritz"].shape == (n_u,):  # warm start, all modes
             r, sv = lanczos["ritz"], ex.start_vector()
             start = r / np.sqrt(ex.dot(r, r)) + WARM_MIX * sv / np.sqrt(
                 ex.dot(sv, sv))
@@ -336,6 +338,7 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             float(saved["base"])
         output_every = int(saved["output_every"])
         F_est = saved.get("F_est")
+        lanczos["ritz"] = saved.get("ritz")
         state = _evaluate(model, u, t, hist, v, exchange=ex)
         fe = f_of(t)
     every = Every.of(checkpoint)
@@ -404,7 +407,9 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             save_run(every, steps, model, u, t, v, a, fi, held, energy, hist,
                      steps=steps, step=step, base=base,
                      output_every=output_every,
-                     **({} if F_est is None else {"F_est": F_est}))
+                     **({} if F_est is None else {"F_est": F_est}),
+                     **({} if lanczos.get("ritz") is None else
+                        {"ritz": lanczos["ritz"]}))
     times["total"] = time.perf_counter() - t_start
     return Trajectory(u, v, a, t, hist, steps, times)
 
