@@ -21,6 +21,8 @@ the kinetic energy an impact destroys is reported as the contact loss
 """
 import numpy as np
 
+from .exchange import SerialExchange
+
 
 class RigidWall:
     """The plane ``x[axis] = position``, the body on ``side`` of it.
@@ -95,7 +97,8 @@ class RigidWall:
         return self.side * force > 0
 
 
-def hold_initial(walls, candidates, u, v, a, m, held, dot=None):
+def hold_initial(walls, candidates, u, v, a, m, held,
+                 dot=SerialExchange.dot):
     """Hold the candidates that start on a wall moving or pushed into it
     (zero normal velocity and acceleration); returns the kinetic energy
     the walls took (``dot``: the sum over dofs, of all ranks on MPI).
@@ -115,7 +118,6 @@ def hold_initial(walls, candidates, u, v, a, m, held, dot=None):
         into = w.side * (v[c] + a[c]) < 0
         h = c[on & into]
         held[h] = True
-        lost += 0.5 * (float(np.dot(m[h], v[h] ** 2)) if dot is None
-                       else dot(m, v * v, h))
+        lost += 0.5 * dot(m, v * v, h)
         v[h], a[h] = 0.0, 0.0
     return lost

@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import FamilyError, ParticleError
 from ..progress import Echo
 from .checkpoint import load as load_checkpoint
+from .exchange import SerialExchange
 from .static import padded_vector
 
 
@@ -107,7 +108,7 @@ class EnergyBalance:
         self.m = m
         # sums over dofs: the serial dot product, or one over the owned
         # dofs of all ranks (HaloExchange.dot)
-        self.dot = _dot if dot is None else dot
+        self.dot = SerialExchange.dot if dot is None else dot
         self.T0 = self.kinetic(v0, free)
         self.W_int = self.W_ext = self.W_D = self.D_c = 0.0
         # the energy scale of the relative error: the largest energy met
@@ -168,12 +169,6 @@ class EnergyBalance:
             out["stored"] = stored
             out["dissipation"] = self.W_int - stored
         return out
-
-
-def _dot(a, b, idx=None):
-    if idx is None:
-        return float(np.dot(a, b))
-    return float(np.dot(a[idx], b[idx]))
 
 
 class DynamicsError(RuntimeError):

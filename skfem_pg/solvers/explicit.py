@@ -25,7 +25,8 @@ the material held elastic (:meth:`History.elastic_predictor
 <skfem_pg.formulations.history.History.elastic_predictor>`: the plastic
 tangent is softer than elastic unloading, which sets the limit),
 by Lanczos iterations (:func:`lanczos_max`, from a start vector fixed by
-the serial dof numbers) on :math:`M^{-1/2} K M^{-1/2}`.  As the configuration changes the step is
+the serial dof numbers) on :math:`M^{-1/2} K M^{-1/2}`.  As the
+configuration changes the step is
 divided by :func:`compression_since` the last estimate (how much the most
 compressed point shrank since), and estimated again every
 ``estimate_every`` steps or as soon as that factor exceeds
@@ -62,18 +63,6 @@ from ..discretization.particles import inverted_cells
 #: the first steps (8 % at step 1, 0.4 % at step 10 in the wave-arrival
 #: test) and then settles; an unstable step grows without bound
 STARTUP_STEPS = 10
-
-
-#: whether a stable-step estimate starts from the previous one's Ritz
-#: vector: off, because a warm start converged to a lower Ritz value on
-#: the crack-aware strip after a family rebuild (energy balance error
-#: 2.4e-3 against 7.7e-4 cold)
-WARM_START = False
-
-
-#: the share of the start vector mixed into the previous estimate's Ritz
-#: vector when a stable-step estimate starts from it (warm start)
-WARM_MIX = 0.1
 
 
 #: a stable-step estimate is repeated at once when a point has been
@@ -117,17 +106,14 @@ def _elastic(model):
         contextlib.nullcontext()
 
 
-def max_frequency(model, m, x, free=None, tol=1e-3, exchange=None,
-                  start=None, out=None):
+def max_frequency(model, m, x, free=None, tol=1e-3, exchange=None):
     r""":math:`\omega_{max} = \sqrt{\lambda_{max}(M^{-1}K)}` of the
     tangent at ``x`` on the ``free`` displacement dofs (default all with
     mass), the material held elastic; the symmetric part of a
     Petrov–Galerkin tangent.  Lanczos iterations (:func:`lanczos_max`,
     Ritz residual ``tol`` relative) on :math:`M^{-1/2} K M^{-1/2}`;
-    ``exchange`` (default serial) sums the products over MPI ranks,
-    ``start`` is a start vector (default
-    :func:`~skfem_pg.solvers.exchange.start_vector` of the dof numbers),
-    ``out`` a dict that receives the Ritz vector and the iterations."""
+    ``exchange`` (default serial) sums the products over MPI ranks and
+    gives the start vector (a function of the serial dof numbers)."""
     exchange = SerialExchange(m.shape[0]) if exchange is None else exchange
     n_u = m.shape[0]
     free = m > 0 if free is None else free & (m > 0)
@@ -140,11 +126,8 @@ def max_frequency(model, m, x, free=None, tol=1e-3, exchange=None,
         y = s * y
         return s * exchange.complete(0.5 * (K @ y + KT @ y))
 
-    v0 = exchange.start_vector() if start is None else start
-    lam, ritz, its = lanczos_max(matvec, np.where(free, v0, 0.0),
-                                 exchange, tol)
-    if out is not None:
-        out.update(ritz=ritz, iterations=its)
+    lam = lanczos_max(matvec, np.where(free, exchange.start_vector(), 0.0),
+                      exchange, tol)[0]
     return float(np.sqrt(max(lam, 0.0)))
 
 
@@ -194,12 +177,11 @@ def lanczos_max(matvec, v0, exchange, tol=1e-3, maxiter=LANCZOS_MAXITER):
 
 
 def stable_time_step(model, m, x=None, free=None, safety=0.8,
-                     exchange=None, start=None, out=None):
+                     exchange=None):
     r"""The central-difference step :math:`s \cdot 2/\omega_{max}`
     (:func:`max_frequency`) at ``x`` (default the initial unknowns)."""
     x = model.initial() if x is None else x
-    w = max_frequency(model, m, x, free, exchange=exchange, start=start,
-                      out=out)
+    w = max_frequency(model, m, x, free, exchange=exchange)
     if not w > 0:
         raise ValueError("no stiffness on the free dofs (omega_max = {}): "
                          "no stable step".format(w))
@@ -255,8 +237,7 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         A path or :class:`~skfem_pg.solvers.checkpoint.Every` (e.g.
         ``Every("taylor.npz", seconds=600)``) to write the run's state to
         (time, displacements, velocities, accelerations, internal force,
-        held dofs, the step estimate, the deformation it was made at and its
-        Ritz vector (the next estimate's start),
+        held dofs, the step estimate and the deformation it was made at,
         energy accounts, records, the model's history; atomically); a path
         to resume such a run from: it then ends where the uninterrupted
         run ends, to round-off.
@@ -317,17 +298,12 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
 
     step = dt
     F_est = None  # the deformation at the last estimate
-    lanczos = {}  # the last estimate's Ritz vector: the next one's start
 
     def estimate():
-        start = None
-        if WARM_START and lanczos.get("ritz") is not None and \
-                lanczos["ritz"].shape == (n_u,):  # warm start, all modes
-            r, sv = lanczos["ritz"], ex.start_vector()
-            start = r / np.sqrt(ex.dot(r, r)) + WARM_MIX * sv / np.sqrt(
-                ex.dot(sv, sv))
-        return stable_time_step(model, m, u, free, safety, exchange=ex,
-                                start=start, out=lanczos)
+        # always from the same start vector: a warm start from the last
+        # Ritz vector converged to a lower Ritz value after a crack-aware
+        # rebuild (energy balance error 2.4e-3 against 7.7e-4 cold)
+        return stable_time_step(model, m, u, free, safety, exchange=ex)
 
     if step is None:
         t1 = time.perf_counter()
@@ -345,7 +321,6 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             float(saved["base"])
         output_every = int(saved["output_every"])
         F_est = saved.get("F_est")
-        lanczos["ritz"] = saved.get("ritz")
         state = _evaluate(model, u, t, hist, v, exchange=ex)
         fe = f_of(t)
     every = Every.of(checkpoint)
@@ -414,9 +389,7 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             save_run(every, steps, model, u, t, v, a, fi, held, energy, hist,
                      steps=steps, step=step, base=base,
                      output_every=output_every,
-                     **({} if F_est is None else {"F_est": F_est}),
-                     **({} if lanczos.get("ritz") is None else
-                        {"ritz": lanczos["ritz"]}))
+                     **({} if F_est is None else {"F_est": F_est}))
     times["total"] = time.perf_counter() - t_start
     return Trajectory(u, v, a, t, hist, steps, times)
 
