@@ -12,6 +12,11 @@ particles it owns; PETSc sums the ranks' parts and solves.
                    (rows summed by their owners), KSP with GAMG and the
                    rigid-body near-null space, options strings
 ``solve``          linear solve and Newton's method on PETSc
+``halo``           the halo exchange of a run on local vectors (sum to
+                   the owners, copy back) and the reductions
+``explicit``       central differences on ranks (the serial skeleton
+                   with the exchange injected), lumped mass, per-rank
+                   checkpoints, FE bases on a rank's cells
 ``io``             parallel VTU: a piece per rank and the ``.pvtu``
 ``comm``           the optional MPI stack (mpi4py, petsc4py, pymetis)
 =================  =====================================================
@@ -23,7 +28,10 @@ from .comm import as_mpi
 from .partition import Partition, metis_parts
 from .solve import solve, newton
 from .io import write_pvtu
+from .halo import HaloExchange
+from .explicit import central_difference, lumped_mass
 from . import petsc
 
 __all__ = ["Partition", "metis_parts", "solve", "newton", "petsc",
-           "as_mpi", "write_pvtu"]
+           "as_mpi", "write_pvtu", "HaloExchange", "central_difference",
+           "lumped_mass"]

@@ -314,6 +314,13 @@ class Partition:
         self.ncomp = 1 if basis.ncomp is None else int(basis.ncomp)
         return basis
 
+    def fe_basis(self, element):
+        """This rank's scikit-fem basis of ``element`` on its FE cells, on
+        a mesh of its local vertices (an FE model run on ranks:
+        :func:`skfem_pg.distributed.explicit.fe_basis`)."""
+        from .explicit import fe_basis
+        return fe_basis(self, element)
+
     # -- FE cells of a coupled model ------------------------------------------
     def fe_assemble(self, form, element, **kwargs):
         """The rank's part of an FE form on its FE cells

@@ -1,0 +1,249 @@
+r"""Explicit central differences on MPI ranks: the serial time-stepping
+skeleton (:func:`skfem_pg.solvers.central_difference`) on each rank's
+local vectors, with the communication of
+:class:`~skfem_pg.distributed.halo.HaloExchange` injected.
+
+Per step a rank evaluates the internal force of the families (or FE
+cells) it owns on its local particles (owned + halo), and one exchange
+sums the contributions at each particle to its owner and copies the total
+back to the ranks that hold the particle as halo.  The rank then
+integrates all its local dofs; its halo copies stay equal to their owners'
+values because every operand is.  Lumped masses, loads and prescribed
+motions are per particle and need no exchange.  Energies, the minimum J
+and the stable-step estimate (Lanczos iterations with distributed
+products, :func:`~skfem_pg.solvers.explicit.lanczos_max`) are reduced
+over the ranks.  History lives with the points of a rank's families.
+
+Inputs are given as in a serial run, in scikit-fem's serial numbering and
+the same on every rank; the result comes back in the serial numbering on
+every rank.
+
+Checkpoints: every rank writes its own piece (``<stem>.rank<r>.step<k>
+.npz``, atomically), then rank 0 writes the manifest ``<stem>.npz``
+naming the step; the previous pieces are removed only after that.  A run
+killed at any moment leaves a manifest whose pieces are complete.  Resume
+on the same number of ranks and the same partition (the pieces carry the
+fingerprint of each rank's model: positions of the local particles).
+"""
+import os
+
+import numpy as np
+import skfem as fem
+
+from ..discretization.layout import is_family_basis
+from ..solvers import explicit as serial
+from ..solvers.checkpoint import Every, atomic_savez, _path
+from ..solvers.dynamics import Trajectory
+from ..solvers.mass import lumped_mass as serial_lumped_mass
+from .halo import HaloExchange
+
+
+def lumped_mass(basis, part, rho):
+    """The diagonal mass on the rank's local dofs: a family basis from
+    :meth:`Partition.basis` (:math:`\\rho_0 V^k` per particle: complete
+    as it is) or an FE basis from :meth:`Partition.fe_basis` (the row sums
+    of the rank's cells, summed over the ranks).  ``rho``: a number, or
+    one value per particle / per element of the mesh (serial
+    numbering)."""
+    rho = np.asarray(rho, dtype=float)
+    if is_family_basis(basis):
+        if rho.ndim == 1 and rho.shape[0] == part.n:
+            rho = rho[part.local]
+        return serial_lumped_mass(basis, rho)
+    if rho.ndim == 1 and rho.shape[0] == part.mesh.nelements:
+        rho = rho[part.fe_cells]
+    nc = basis.N // len(part.local)
+    m = HaloExchange(part, nc).complete(_fe_row_sums(basis, rho))
+    bad = np.flatnonzero(~(m > 0))
+    if bad.size:
+        raise ValueError("lumped mass {:.3g} at particle {} (serial "
+                         "numbering): row-sum lumping needs linear elements"
+                         .format(m[bad[0]], part.local[bad[0] // nc]))
+    return m
+
+
+def _fe_row_sums(basis, rho):
+    """The rank's part of the row-sum lumped mass (zero rows where the
+    rank has no cell at a vertex: the serial check of positive entries
+    applies after the sum)."""
+    from ..solvers.mass import _mass_form, _per
+    nel = basis.mesh.t.shape[1]
+    rho = _per(rho, nel, "element")
+    rho_q = np.broadcast_to(rho[:, None], basis.dx.shape)
+    return np.asarray(_mass_form.assemble(basis, rho=rho_q).sum(
+        axis=1)).ravel()
+
+
+class RankCheckpoints(Every):
+    """A :class:`~skfem_pg.solvers.checkpoint.Every` for a run on ranks:
+    rank 0 decides when (its clock), every rank writes its piece, rank 0
+    the manifest (module docstring)."""
+
+    def __init__(self, every, part):
+        super().__init__(every.path, every.steps, every.seconds)
+        self.part = part
+        self._piece = None
+
+    def piece(self, count, rank=None):
+        stem = self.path[:-len(".npz")]
+        return "{}.rank{}.step{}.npz".format(
+            stem, self.part.rank if rank is None else rank, count)
+
+    def due(self, count):
+        return self.part.comm.bcast(super().due(count), root=0)
+
+    def write(self, count, model, x, load, **state):
+        from ..solvers.checkpoint import save
+        comm = self.part.comm
+        piece = save(self.piece(count), model, x, load, **state)
+        comm.barrier()  # every piece of step `count` is on disk
+        if self.part.rank == 0:
+            atomic_savez(self.path, ranks=self.part.size, step=count)
+        comm.barrier()
+        if self._piece is not None and self._piece != piece and \
+                os.path.exists(self._piece):
+            os.unlink(self._piece)
+        self._piece = piece
+
+
+def resume_piece(path, part):
+    """The piece of this rank named by the manifest ``path`` of
+    :class:`RankCheckpoints`."""
+    path = _path(path)
+    try:
+        with np.load(path) as f:
+            ranks, step = int(f["ranks"]), int(f["step"])
+    except (OSError, KeyError, ValueError) as err:
+        raise ValueError("{} is not the manifest of a checkpoint on ranks "
+                         "({}: {})".format(path, type(err).__name__, err)) \
+            from None
+    if ranks != part.size:
+        raise ValueError("checkpoint {} was written on {} ranks, this run "
+                         "has {}: resume on as many ranks".format(
+                             path, ranks, part.size))
+    stem = path[:-len(".npz")]
+    return "{}.rank{}.step{}.npz".format(stem, part.rank, step)
+
+
+def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
+                       u0=None, v0=None, dt=None, wall=None, callback=None,
+                       checkpoint=None, resume=None, controls=None, **kw):
+    r"""Central differences (:func:`skfem_pg.solvers.central_difference`)
+    for a model on this rank's local basis (:meth:`Partition.basis` or
+    :meth:`Partition.fe_basis`), collectively on all ranks of ``part``.
+
+    ``m`` is the local lumped mass (:func:`lumped_mass`); ``f_ext``,
+    ``u_D`` (vectors or callables of the time), ``u0``, ``v0`` and the
+    prescribed dofs ``D`` are serial (scikit-fem numbering, the same on
+    every rank); ``wall``, ``dt``, ``controls`` / ``kw`` as in the serial
+    driver.  ``callback(t, x, v, record)`` receives serial vectors
+    (gathered on every rank: collective).  ``checkpoint`` / ``resume``:
+    the manifest path of :class:`RankCheckpoints`.
+
+    Returns the serial :class:`~skfem_pg.solvers.dynamics.Trajectory` with
+    ``x``, ``v``, ``a`` in the serial numbering on every rank; the
+    energies are those of the whole body.
+    """
+    n_u = getattr(model, "n_u", model.basis.N)
+    if getattr(model, "N", n_u) != n_u:
+        raise NotImplementedError(
+            "{} has global unknowns beyond the displacements: explicit "
+            "steps on ranks take displacement models".format(
+                type(model).__name__))
+    if hasattr(model, "separate"):
+        raise NotImplementedError(
+            "{}: crack-aware family updates rebuild the partition's "
+            "families; on ranks this version runs fracture with the "
+            "connectivity kept (a Hyperelastic model with a damage "
+            "material)".format(type(model).__name__))
+    nc = n_u // len(part.local) if len(part.local) else 0
+    if nc * len(part.local) != n_u or nc < 1:
+        raise ValueError("the model is not on this partition's local "
+                         "particles ({} dofs, {} local particles)".format(
+                             n_u, len(part.local)))
+    ex = HaloExchange(part, nc)
+    lsd = ex.serial_dofs()
+    N = nc * part.n
+
+    def local(v, what):
+        if v is None:
+            return None
+        if callable(v):
+            return lambda t: local(v(t), what + "(t)")
+        v = np.asarray(v, dtype=float)
+        if v.shape != (N,):
+            raise ValueError("{} is a serial vector of {} entries, got "
+                             "shape {}".format(what, N, v.shape))
+        return v[lsd]
+
+    if D is not None:
+        from ..dofs import as_dofs
+        mask = np.zeros(N, dtype=bool)
+        mask[as_dofs(D, N, "Dirichlet dofs (serial numbering)")] = True
+        D = np.flatnonzero(mask[lsd])
+    walls = [] if wall is None else (list(wall) if isinstance(
+        wall, (list, tuple)) else [wall])
+    for w in walls:  # the serial default tolerance: of the whole body
+        if w.tol is None:
+            w.tol = 1e-9 * max(np.ptp(part.particles.x[w.axis]), 1e-300)
+
+    def gather(x):
+        return gather_owned(part, x, nc)
+
+    cb = None
+    if callback is not None:
+        def cb(t, x, v, rec):
+            callback(t, gather(x), gather(v), rec)
+    every = Every.of(checkpoint)
+    if every is not None:
+        every = RankCheckpoints(every, part)
+    if resume is not None:
+        resume = resume_piece(resume, part)
+    traj = serial.central_difference(
+        model, m, t_end, f_ext=local(f_ext, "f_ext"), D=D,
+        u_D=local(u_D, "u_D"), u0=local(u0, "u0"), v0=local(v0, "v0"),
+        dt=dt, wall=walls or None, callback=cb, checkpoint=every,
+        resume=resume, controls=controls, exchange=ex, **kw)
+    traj.times["messages"] = ex.messages
+    return Trajectory(gather(traj.x), gather(traj.v), gather(traj.a),
+                      traj.t, traj.history, traj.steps, traj.times)
+
+
+def gather_owned(part, x, nc):
+    """A local vector (``nc`` components per local particle, owned first)
+    in the serial numbering on every rank."""
+    own = np.asarray(x[:nc * len(part.owned)], dtype=float)
+    parts = part.comm.allgather(own)
+    owned = part.comm.allgather(part.owned)
+    out = np.empty(nc * part.n)
+    for o, p in zip(owned, parts):
+        out.reshape(-1, nc)[o] = p.reshape(-1, nc)
+    return out
+
+
+def fe_basis(part, element):
+    """This rank's FE basis for a run on ranks: ``element`` (linear:
+    T1, Q1, O1, H1, vectorial) on the partition's FE cells that the rank
+    assembles, on a mesh of its local vertices (owned, then the other
+    vertices of its cells), so that the dofs are the local ones of
+    :class:`HaloExchange`.  Sets ``part.local``."""
+    mesh, cells = part.mesh, part.fe_cells
+    if len(cells) == 0:
+        raise ValueError("rank {} assembles no FE cell (the partition's "
+                         "fe_elements: a cell goes to the owner of its first "
+                         "vertex)".format(part.rank))
+    halo = np.setdiff1d(mesh.t[:, cells], part.owned)
+    local = np.concatenate([part.owned, halo])
+    index = np.full(part.n, -1, dtype=np.int64)
+    index[local] = np.arange(len(local))
+    sub = type(mesh)(mesh.p[:, local], index[mesh.t[:, cells]])
+    basis = fem.Basis(sub, element)
+    nc = basis.N // max(len(local), 1)
+    if nc * len(local) != basis.N:
+        raise ValueError("fe_basis takes linear elements (one dof per "
+                         "vertex and component): {} has {} dofs on {} "
+                         "vertices".format(type(element).__name__, basis.N,
+                                           len(local)))
+    part.local = local
+    part.ncomp = nc
+    return basis
