@@ -150,7 +150,7 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
             "{} has global unknowns beyond the displacements: explicit "
             "steps on ranks take displacement models".format(
                 type(model).__name__))
-    if hasattr(model, "separate"):
+    if hasattr(model, "cells_to_fail"):  # crack-aware families
         raise NotImplementedError(
             "{}: crack-aware family updates rebuild the partition's "
             "families; on ranks this version runs fracture with the "

@@ -136,12 +136,18 @@ def under_integrated(basis):
     if basis.vc not in (None, "V3", "V5"):
         raise ValueError("U1SUnl / U1SIG: first-order VC (V3, V5) or none, "
                          "got vc={!r}".format(basis.vc))
+    on_ranks = {}
+    part = getattr(basis, "distributed", None)
+    if part is not None:  # a rank's part: its VC is solved over the ranks
+        on_ranks["distributed"] = part
+        if basis.vc is not None:
+            on_ranks["area_vectors"] = part.area_vectors()[:, part.local]
     return FamilyBasis(basis.particles, families=basis.families,
                        shape="WTE1", bond=False,
                        vc=None if basis.vc is None else "V3",
                        vc_boundary=basis.vc_boundary, dim=basis.ncomp,
                        weight_exponent=basis.weight_exponent,
-                       weights=basis.weights)
+                       weights=basis.weights, **on_ranks)
 
 
 class _MasterModel(Hyperelastic):
