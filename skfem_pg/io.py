@@ -119,17 +119,27 @@ class VTUSeries:
     rewritten after each step (an interrupted run leaves a readable
     series).  ``add(t, write)`` calls ``write(filename)`` — e.g.
     :func:`write_vtu` of the particles, or meshio for an FE mesh — and
-    returns the file's name."""
+    returns the file's name.
 
-    def __init__(self, folder):
+    A run on MPI ranks writes ``suffix="pvtu"`` files
+    (:func:`skfem_pg.distributed.write_pvtu`, called by every rank) and
+    the collection on one rank only (``collection=rank == 0``)."""
+
+    def __init__(self, folder, suffix="vtu", collection=True):
+        if suffix not in ("vtu", "pvtu"):
+            raise ValueError("a VTU series holds .vtu or .pvtu files, got "
+                             "suffix={!r}".format(suffix))
         self.folder, self.entries = folder, []
+        self.suffix, self.collection = suffix, collection
         os.makedirs(folder, exist_ok=True)
 
     def add(self, t, write):
-        fn = os.path.join(self.folder, "step_{:03d}.vtu".format(
-            len(self.entries)))
+        fn = os.path.join(self.folder, "step_{:03d}.{}".format(
+            len(self.entries), self.suffix))
         write(fn)
         self.entries.append((float(t), os.path.basename(fn)))
+        if not self.collection:
+            return fn
         sub = os.path.basename(os.path.normpath(self.folder))
         with open(os.path.normpath(self.folder) + ".pvd", "w") as f:
             f.write('<?xml version="1.0"?>\n<VTKFile type="Collection">\n'
