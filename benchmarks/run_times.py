@@ -112,6 +112,11 @@ SCRIPTS = [
      "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
      "Newton and KSP iterations, difference to the serial run (serial "
      "here)", "20 s", 20),
+    ("taylor_mpi", ["demos/taylor_mpi.py"],
+     "thesis 7.3.7 on 1 or 2 MPI ranks (`mpirun -n 2`): explicit central "
+     "differences on ranks against the serial run (steps, difference, "
+     "time split per rank, particle-steps/s); .pvtu series", "1.7 min",
+     100),
     ("assembly_scaling", ["benchmarks/assembly_scaling.py"],
      "preprocessing / assembly / solve vs Q1 (2-D, up to 251k particles) "
      "and H1 (`--dim 3`), both FE assembly paths", "minutes", 600),
