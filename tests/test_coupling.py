@@ -14,7 +14,7 @@ VARIANTS = [dict(), dict(vc_boundary="p"), dict(vc_boundary="s"),
             dict(vc_boundary="sn"), dict(method="PPG1"),
             dict(method="PPG1", vc_boundary="p"),
             dict(method="PPG1", vc_boundary="s"),
-            dict(method="PPG1", vc_boundary="sn")]
+            dict(method="PPG1", vc_boundary="sn"), dict(vc_solver="local")]
 
 
 @pytest.mark.parametrize("kw", VARIANTS)

@@ -539,3 +539,35 @@ def test_explicit_refusals_on_ranks():
     # driver takes damage with the connectivity kept
     with pytest.raises(ValueError, match="collocation mesh"):
         CrackAware(b, J2_DAMAGE)
+
+
+# -- local VC: no global system ----------------------------------------------
+@pytest.mark.parametrize("dim", [2, 3])
+def test_local_vc_patch_test_on_ranks(dim):
+    """``vc_solver="local"``: each rank corrects its own families (no
+    system on rank 0); the patch test holds and the basis is the serial
+    one (the serial solution to round-off)."""
+    if dim == 2:
+        mesh = square(10, 0.3, seed=7, kind="tri")
+        e, G = fem.ElementVector(fem.ElementTriP1()), GEX
+    else:
+        mesh = cube(4, 0.25, seed=3)
+        e, G = fem.ElementVector(fem.ElementHex1()), GEX3
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=dim, vc_solver="local")
+    assert basis.vc_report.solver == "local"
+    assert basis.vc_report.residual_after < 1e-12
+    D = fem.Basis(mesh, e).get_dofs()
+    uex = (G @ mesh.p).T.ravel()
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, D=D, u_D=uex)
+    assert np.abs(u - uex).max() <= 1e-10
+    # a load: the serial local-VC solution
+    sb = pg.FamilyBasis(mesh, dim=dim, vc_solver="local")
+    Dl = fem.Basis(mesh, e).get_dofs(
+        lambda x: np.isclose(x[0], mesh.p[0].min())).all()
+    f = np.zeros(sb.N)
+    f[1::dim] = 1e-3
+    u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=Dl))
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=Dl,
+                      options="-ksp_rtol 1e-13")
+    assert rel(u, u_s) <= 1e-9

@@ -53,6 +53,7 @@ from .shape.least_squares import (mls1_master_gradients,
                                    wls2_master_gradients)
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
+from . import local_vc
 from ..naming import parse
 
 METHODS = ("PBG", "PPG1", "PPG2")
@@ -206,6 +207,17 @@ class BasisSpec:
         if vc == "V5" and not bond:
             raise ValueError("vc='V5' keeps the bond mapping and needs "
                              "bond=True; use vc='V3' without bond correction")
+        if vc_solver == "local" and not (
+                method == "PBG" and shape in ("MTE1", "WTE1")
+                and vc in ("V3", "V5") and vc_boundary == "min-norm"
+                and vc_exclude is None):
+            raise NotImplementedError(
+                "vc_solver='local' (skfem_pg.discretization.local_vc) "
+                "corrects PBG on MTE1/WTE1 with vc V3 or V5, "
+                "vc_boundary='min-norm' and no vc_exclude; got {} {} vc={} "
+                "vc_boundary={!r}{}".format(
+                    method, shape, vc, vc_boundary,
+                    "" if vc_exclude is None else " with vc_exclude"))
         if vc_boundary != "min-norm" and (
                 vc is None or method == "PPG2"
                 or (vc == "VC2" and vc_boundary != "s")):
@@ -513,8 +525,11 @@ def build(particles, spec, area_vectors=None, distributed=None):
     t0 = time.perf_counter()
     fam = make_families(particles, spec, distributed)
     timings["families"] = time.perf_counter() - t0
-    vc_solve = (vc_correction if distributed is None
-                else distributed.vc_correction)
+    if spec.vc_solver == "local":  # no global system, on ranks neither
+        vc_solve = local_vc.local_solver(particles, distributed)
+    else:
+        vc_solve = (vc_correction if distributed is None
+                    else distributed.vc_correction)
     stages = _grouped if spec.grouped else _padded
     return stages(particles, fam, spec, area_vectors, vc_solve, timings)
 
