@@ -96,7 +96,10 @@ def affine(basis, F):
 @pytest.mark.parametrize("dim, vc, kind", [(2, "V5", "Unl"),
                                            (2, None, "Unl"),
                                            (3, "V5", "Unl"),
-                                           (2, "V3", "U1SIG")])
+                                           (2, "V3", "U1SIG"),
+                                           (2, "V5 local", "Unl"),
+                                           (3, "V5 local", "Unl"),
+                                           (2, "V3 local", "U1SIG")])
 def test_a_cut_body_passes_the_linear_patch_test(dim, vc, kind):
     """Cells failed across a body (the crack: a layer of cells): after the
     update the families stop at the crack and the crack faces enter the
@@ -106,15 +109,19 @@ def test_a_cut_body_passes_the_linear_patch_test(dim, vc, kind):
     prescribed: the residual at the free particles — those on the crack
     faces among them — is round-off with VC (measured 1.2e-13 relative,
     2-D on 8 x 8 quads and 3-D on 4 x 4 x 4 hexahedra; U1SIG on its
-    WTE1 V3 basis also 1.2e-13) and not without (0.13, 2-D)."""
+    WTE1 V3 basis also 1.2e-13) and not without (0.13, 2-D); the local
+    correction (``vc_solver="local"``) redone on the cut body too."""
     n = 8 if dim == 2 else 4
     mesh = shifted_grid(n, n, amount=0.5, nz=None if dim == 2 else n)
+    kw = {}
+    if vc is not None and vc.endswith(" local"):
+        vc, kw = vc.split()[0], {"vc_solver": "local"}
     if kind == "U1SIG":
         basis = pg.FamilyBasis(mesh, dim=dim, shape="WTE1", bond=False,
-                               vc=vc)
+                               vc=vc, **kw)
         model = CrackAwareU1SIG(basis, STEEL)
     else:
-        basis = pg.FamilyBasis(mesh, dim=dim, vc=vc)
+        basis = pg.FamilyBasis(mesh, dim=dim, vc=vc, **kw)
         model = CrackAware(basis, STEEL)
     crack = row_of_cells(mesh, (n // 2 + 0.5) / n)
     zero = np.zeros(basis.N)
@@ -262,7 +269,9 @@ def test_crack_aware_refuses_what_it_cannot_do():
             mesh, kind="centroids"), dim=2), STEEL)
 
 
-def test_crack_aware_strip_separates_where_the_thesis_variant_holds():
+@pytest.mark.parametrize("vc_solver", ["auto", "local"])
+def test_crack_aware_strip_separates_where_the_thesis_variant_holds(
+        vc_solver):
     """The notched strip of ``test_fracture`` (VC PBG Unl, Johnson–Cook
     damage, 6 x 12 cells): crack-aware families fail the notch row's four
     cells right of the root and the strip comes apart — no family spans
@@ -276,7 +285,7 @@ def test_crack_aware_strip_separates_where_the_thesis_variant_holds():
     in both (mean over the last half -57 N and +5 N, peak 8495 N)."""
     n = 6
     mesh, y_notch = strip(n, notch_cells=True)
-    basis = pg.FamilyBasis(mesh, dim=2)
+    basis = pg.FamilyBasis(mesh, dim=2, vc_solver=vc_solver)
     model = CrackAware(basis, STEEL)
     tr, first = pull(model, basis, 0.02, 2000.0, grip=0.0)
     c = mesh.p[:, mesh.t].mean(axis=1)
@@ -297,6 +306,8 @@ def test_crack_aware_strip_separates_where_the_thesis_variant_holds():
     y = basis.particles.x[1]
     assert np.abs(uy[y < y_notch]).max() < 1.0
     assert uy[y > y_notch].min() > 30.0
+    if vc_solver == "local":
+        assert model.current.vc_report.solver == "local"
 
 
 @pytest.mark.parametrize("kind", ["Unl", "U1SIG"])
