@@ -20,7 +20,7 @@ from skfem_pg.analysis import PATCH_GRADIENT_3D as GEX3
 from skfem_pg.formulations import (CrackAware, Hyperelastic,
                                    linear_elasticity, model_for)
 from skfem_pg.materials import (CriticalStrainDamage, J2Plasticity,
-                                NeoHooke, lame)
+                                NeoHooke, NeoHookeIsoVol, lame)
 from conftest import cube, square
 
 pytest.importorskip("mpi4py")
@@ -571,3 +571,29 @@ def test_local_vc_patch_test_on_ranks(dim):
     u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=Dl,
                       options="-ksp_rtol 1e-13")
     assert rel(u, u_s) <= 1e-9
+
+
+# -- family-local mixed fields in Newton -------------------------------------
+@pytest.mark.parametrize("formulation, material", [
+    ("UnlP0", NeoHookeIsoVol(MU, LAM + 2 * MU / 3)),
+    ("UnlP0", J2Plasticity(LAM, MU, 20.0)),
+    ("U1SIG", J2Plasticity(LAM, MU, 20.0))])
+def test_condensed_mixed_newton_equals_serial(formulation, material):
+    """UnlP0 (a pressure and dilatation per family, condensed) and U1SIG
+    (the stabilization at the masters) in the distributed Newton, elastic
+    and plastic (history per rank): the serial solution to round-off."""
+    mesh, f, D = cantilever3d(4)
+    load = 0.5 * f  # tip 0.19, max e_p 0.11 (UnlP0), 0.024 (U1SIG)
+    ms = model_for(formulation, pg.FamilyBasis(mesh, dim=3), material)
+    u_s, hs = pg.solvers.newton(ms, load, D=D, steps=2, tol=1e-12,
+                                verbose=False)
+    part = dist.Partition(mesh, COMM)
+    md = model_for(formulation, part.basis(dim=3), material)
+    u, hist = dist.newton(md, part, load, D=D, steps=2, tol=1e-12,
+                          verbose=False)
+    assert rel(u, u_s) <= 1e-10
+    assert [h["load"] for h in hist] == [h["load"] for h in hs]
+    if isinstance(material, J2Plasticity):
+        ep_s = ms.plastic_strain()[1]
+        ep = max(COMM.allgather(md.plastic_strain()[1]))
+        assert ep_s > 0 and abs(ep - ep_s) <= 1e-10 * ep_s
