@@ -77,11 +77,27 @@ def smoothed_gradients(mesh, elements=None, rows=None):
         hit = np.zeros(mesh.nvertices, dtype=bool)
         hit[rows] = True
         tind = tind[hit[mesh.t[:, tind]].any(axis=0)]
-    basis = fem.Basis(mesh, e1, elements=tind)
-    d = mesh.dim()
-    return [fem.BilinearForm(
-        lambda u, v, w, c=c: v * u.grad[c]).assemble(basis).tocsr()
-        for c in range(d)]
+    # N_k dN_i det J is a polynomial of degree 1 (simplices) or 3 per
+    # direction (quads, hexes): exact with intorder 2 and 3 (then the
+    # shares sum exactly to the area vectors and lumped volumes)
+    simplex = mesh.t.shape[0] == mesh.dim() + 1
+    basis = fem.CellBasis(mesh, e1, elements=tind,
+                          intorder=2 if simplex else 3)
+    phi = np.array([np.asarray(b[0]) for b in basis.basis])  # (nb, nel, nq)
+    dphi = np.array([b[0].grad for b in basis.basis])  # (nb, d, nel, nq)
+    t = mesh.t[:, tind]
+    nb = t.shape[0]
+    rows_ = np.repeat(t, nb, axis=0)  # k of entry (k, i)
+    cols_ = np.tile(t, (nb, 1))
+    out = []
+    for c in range(mesh.dim()):
+        # (nb_k, nb_i, nel): sum_q dx N_k d_c N_i
+        E = np.einsum("keq,ieq,eq->kie", phi, dphi[:, c], basis.dx)
+        out.append(sp.coo_matrix(
+            (E.reshape(nb * nb, -1).ravel(), (rows_.ravel(),
+                                              cols_.ravel())),
+            shape=(mesh.nvertices, mesh.nvertices)).tocsr())
+    return out
 
 
 def family_shares(S, masters, mem, mask, x):
@@ -170,8 +186,8 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         beta = np.linalg.solve(Bp[:, None], (target - sh)[..., None])[..., 0]
         beta *= mask[..., None]
         # C^{kji} = Q^{kj} beta^{ki} at the real members j
-        C = np.einsum("kjab,kib->kjia", Q, beta) * mask[:, :, None, None]
-        Gc.append(Gp + C)
+        C = np.matmul(Q, np.swapaxes(beta, 1, 2)[:, None])  # (k, j, a, i)
+        Gc.append(Gp + np.swapaxes(C, 2, 3) * mask[:, :, None, None])
     r1, keep = complete(vc_residual(parts, Gc, n))
     rep = VCReport(
         variant=variant, solver="local", unknowns=int(sum(
