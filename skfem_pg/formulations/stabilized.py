@@ -156,6 +156,12 @@ class _MasterModel(Hyperelastic):
     state, and the stabilization moduli (6.20) frozen per step."""
 
     name = "U1S"
+    #: the explicit driver's stable-step estimate forms its tangent
+    #: products from internal forces (:func:`skfem_pg.solvers.explicit.
+    #: max_frequency`): the material at the masters makes a force far
+    #: cheaper than an assembled tangent (benchmarks/README.md, "stable
+    #: step")
+    matrix_free_estimate = True
 
     def __init__(self, basis, u1, material):
         self.mu0, self.K0 = _moduli(material, self.name)
