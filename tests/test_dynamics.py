@@ -290,8 +290,8 @@ def test_matrix_free_estimate_equals_the_assembled_one(formulation):
     """The stable-step estimate from internal-force differences against
     the one of the assembled elastic tangent, on a deformed and plastic
     plate (measured 8e-8 Unl, 1.9e-7 U1SIG relative); U1SIG takes it by
-    default
-    (its force is the cheap one); a Petrov–Galerkin model refuses it."""
+    default (its force is the cheap one); a Petrov–Galerkin model refuses
+    it."""
     from skfem_pg.formulations import model_for
     from skfem_pg.materials import J2Plasticity, lame
     from skfem_pg.solvers.explicit import max_frequency
