@@ -217,17 +217,22 @@ def local_solver(particles, distributed=None):
                 "(Particles.from_mesh), not {}".format(
                     "particles without a mesh" if mesh is None else
                     "{} particles".format(particles.kind)))
-        S = smoothed_gradients(mesh, particles.elements)
+        S = []  # built at the first call: inside the correction's timing
 
         def shares(masters, mem, mask):
+            if not S:
+                S.extend(smoothed_gradients(mesh, particles.elements))
             return family_shares(S, masters, mem, mask, x)
         return functools.partial(local_vc_correction, shares=shares)
     part = distributed
     glob = part.particles
-    S = smoothed_gradients(part.mesh, glob.elements, rows=part.owned)
+    S = []
     A = part.area_vectors()
 
     def shares(masters, mem, mask):
+        if not S:
+            S.extend(smoothed_gradients(part.mesh, glob.elements,
+                                        rows=part.owned))
         return family_shares(S, part.local[masters], part.local[mem], mask,
                              glob.x)
 
