@@ -153,6 +153,10 @@ SCRIPTS = [
     ("mpi_scaling", ["benchmarks/mpi_scaling.py"],
      "strong and weak scaling on 1 and 2 ranks against serial PG and H1 "
      "(sparse direct)", "minutes", 600),
+    ("local_vc", ["benchmarks/local_vc.py"],
+     "local against global VC correction: manufactured rates, linear Cook "
+     "2-D and 3-D against overkills (with H1, O1, O2), the correction's "
+     "cost", "2 min", 120),
 ]
 
 #: the README's test commands: key, pytest arguments, what they run
