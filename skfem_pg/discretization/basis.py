@@ -132,8 +132,8 @@ class FamilyBasis(AbstractBasis):
         ``"petsc"`` (:mod:`skfem_pg.distributed.vc`: solved on all ranks).
         ``"local"`` (:mod:`skfem_pg.discretization.local_vc`, the thesis'
         outlook 8.2) solves no global system: each family meets its share
-        :math:`\int N_k \nabla N_i` of the constraint (the collocation
-        mesh's linear functions), one :math:`d\times d` solve per family
+        :math:`\\int N_k \\nabla N_i` of the constraint (the collocation
+        mesh's linear functions), one :math:`d\\times d` solve per family
         — PBG on MTE1/WTE1 with V3/V5, boundary ``"min-norm"``, families
         holding every element neighbour (the mesh families); on MPI ranks
         no communication.

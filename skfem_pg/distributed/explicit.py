@@ -192,8 +192,9 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
 
     cb = None
     if callback is not None:
-        def cb(t, x, v, rec):
+        def gathered(t, x, v, rec):
             callback(t, gather(x), gather(v), rec)
+        cb = gathered
     every = Every.of(checkpoint)
     if every is not None:
         every = RankCheckpoints(every, part)
