@@ -159,8 +159,8 @@ class _MasterModel(Hyperelastic):
     #: the explicit driver's stable-step estimate forms its tangent
     #: products from internal forces (:func:`skfem_pg.solvers.explicit.
     #: max_frequency`): the material at the masters makes a force far
-    #: cheaper than an assembled tangent (benchmarks/README.md, "stable
-    #: step")
+    #: cheaper than an assembled tangent (benchmarks/README.md, section
+    #: explicit_mpi)
     matrix_free_estimate = True
 
     def __init__(self, basis, u1, material):
