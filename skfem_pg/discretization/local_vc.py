@@ -113,7 +113,7 @@ def family_shares(S, masters, mem, mask, x):
     for c in range(d):
         out[..., c][mask] = np.asarray(
             S[c][rows[mask], mem[mask]]).ravel()
-    total = sum(abs(S[c]) for c in range(d)).tocsr()[masters]
+    total = sum(abs(S[c][masters]) for c in range(d)).tocsr()
     lost = total.sum(axis=1).A1 - np.abs(out).sum(axis=(1, 2))
     bad = np.flatnonzero(lost > 1e-12 * total.sum(axis=1).A1)
     if bad.size:
@@ -189,10 +189,10 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         C = np.matmul(Q, np.swapaxes(beta, 1, 2)[:, None])  # (k, j, a, i)
         Gc.append(Gp + np.swapaxes(C, 2, 3) * mask[:, :, None, None])
     r1, keep = complete(vc_residual(parts, Gc, n))
+    pairs = int(sum(p[2].padded()[1].sum() for p in parts))  # (k, i)
     rep = VCReport(
-        variant=variant, solver="local", unknowns=int(sum(
-            p[2].padded()[1].sum() for p in parts)) * d,
-        constraints=int(sum(p[2].padded()[1].sum() for p in parts)) * d,
+        variant=variant, solver="local", unknowns=pairs * d,
+        constraints=pairs * d,
         residual_before=float(np.abs(r0[keep]).max() / area_scale),
         residual_after=float(np.abs(r1[keep]).max() / area_scale),
         iterations=0, seconds=time.perf_counter() - t0,

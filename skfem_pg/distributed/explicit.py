@@ -34,7 +34,7 @@ from ..discretization.layout import is_family_basis
 from ..solvers import explicit as serial
 from ..solvers.checkpoint import Every, atomic_savez, _path
 from ..solvers.dynamics import Trajectory
-from ..solvers.mass import lumped_mass as serial_lumped_mass
+from ..solvers.mass import lumped_mass as serial_lumped_mass, row_sums
 from .halo import HaloExchange
 
 
@@ -53,25 +53,13 @@ def lumped_mass(basis, part, rho):
     if rho.ndim == 1 and rho.shape[0] == part.mesh.nelements:
         rho = rho[part.fe_cells]
     nc = basis.N // len(part.local)
-    m = HaloExchange(part, nc).complete(_fe_row_sums(basis, rho))
+    m = HaloExchange(part, nc).complete(row_sums(basis, rho))
     bad = np.flatnonzero(~(m > 0))
     if bad.size:
         raise ValueError("lumped mass {:.3g} at particle {} (serial "
                          "numbering): row-sum lumping needs linear elements"
                          .format(m[bad[0]], part.local[bad[0] // nc]))
     return m
-
-
-def _fe_row_sums(basis, rho):
-    """The rank's part of the row-sum lumped mass (zero rows where the
-    rank has no cell at a vertex: the serial check of positive entries
-    applies after the sum)."""
-    from ..solvers.mass import _mass_form, _per
-    nel = basis.mesh.t.shape[1]
-    rho = _per(rho, nel, "element")
-    rho_q = np.broadcast_to(rho[:, None], basis.dx.shape)
-    return np.asarray(_mass_form.assemble(basis, rho=rho_q).sum(
-        axis=1)).ravel()
 
 
 class RankCheckpoints(Every):

@@ -29,6 +29,18 @@ def _mass_form(u, v, w):
     return w.rho * dot(u, v)
 
 
+def row_sums(basis, rho):
+    """The row sums of the consistent mass of a scikit-fem basis, ``rho``
+    a number or one value per element of its mesh (unchecked: on an MPI
+    rank the sums are partial until added over the ranks)."""
+    nel = basis.mesh.t.shape[1]
+    rho = _per(rho, nel, "element")
+    tind = basis.tind if basis.tind is not None else np.arange(nel)
+    rho_q = np.broadcast_to(rho[tind][:, None], basis.dx.shape)
+    return np.asarray(_mass_form.assemble(basis, rho=rho_q).sum(
+        axis=1)).ravel()
+
+
 def lumped_mass(basis: AbstractBasis,
                 rho: float | ArrayLike) -> np.ndarray:
     """The diagonal mass, one entry per dof of ``basis`` (length
@@ -51,12 +63,7 @@ def lumped_mass(basis: AbstractBasis,
                              .format(basis.N, p.n, m.shape[0]))
         where = "particle"
     else:
-        nel = basis.mesh.t.shape[1]
-        rho = _per(rho, nel, "element")
-        tind = basis.tind if basis.tind is not None else np.arange(nel)
-        rho_q = np.broadcast_to(rho[tind][:, None], basis.dx.shape)
-        m = np.asarray(_mass_form.assemble(basis, rho=rho_q).sum(
-            axis=1)).ravel()
+        m = row_sums(basis, rho)
         where = "dof"
     bad = np.flatnonzero(~(m > 1e-12 * np.abs(m).max(initial=0.0)))
     if bad.size:
