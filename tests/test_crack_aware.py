@@ -230,6 +230,34 @@ def test_an_update_makes_debris_inactive_and_a_full_failure_is_an_error():
                      model.state(np.zeros(basis.N))["F"], model.intact)
 
 
+def test_the_history_follows_its_pairs_when_debris_leaves_no_family():
+    """The debris of the bottom row (the lowest particle numbers) masters
+    no family after the update: every surviving point keeps the history
+    of its own (master, member) pair.  Before, points were keyed by the
+    family's index, which shifts past the first inactive particle: the
+    history went to other pairs."""
+    mesh = shifted_grid(4, 4)
+    basis = pg.FamilyBasis(mesh, dim=2)
+    model = CrackAware(basis, STEEL, min_piece=11)
+    from skfem_pg.formulations.updated_lagrange import point_keys
+    n = basis.particles.n
+    keys = point_keys(basis).astype(float)
+    st = model.state(np.zeros(basis.N))
+    model.commit(st)
+    h = model.history.committed
+    h["alpha"] = 1e-9 * keys.reshape(h["alpha"].shape)  # tagged points
+    c = mesh.p[:, mesh.t].mean(axis=1)
+    model.update(np.zeros(basis.N), st["F"],
+                 row_of_cells(mesh, 1.5 / 4) | (c[1] < 0.25))
+    fam = model.current.families
+    assert fam.masters[0] > 0  # particle 0 masters no family any more
+    k_new = point_keys(model.current)
+    assert np.array_equal(k_new, np.repeat(fam.masters, fam.sizes) * n
+                          + np.asarray(fam.members))
+    tags = model.history.committed["alpha"].ravel()
+    assert np.array_equal(tags, 1e-9 * k_new.astype(float))
+
+
 def test_cells_fail_from_their_failed_points():
     """A cell fails when the failed share of its points reaches
     ``fraction``; then a piece smaller than ``min_piece`` goes with it."""

@@ -77,6 +77,20 @@ def test_local_v5_keeps_consistency_and_the_bond_mapping():
     assert _bond_mapping_error(b3) > 1e-3
 
 
+def test_u1sig_on_a_local_vc_basis_corrects_its_u1_basis_locally():
+    """U1SUnl / U1SIG build their U1 basis from the basis they are given:
+    with ``vc_solver="local"`` that one is corrected locally too (before,
+    the solver was dropped and the U1 basis solved the global system)."""
+    from skfem_pg.formulations import U1SIG
+    from skfem_pg.materials import NeoHooke
+    mesh = square(6, 0.2, seed=3, kind="tri")
+    b = pg.FamilyBasis(mesh, dim=2, vc_solver="local")  # MTE1, V5
+    u1 = U1SIG(b, NeoHooke(1.0, 1.0)).u1
+    assert u1 is not b and u1.shape == "WTE1"
+    assert u1.vc_report.solver == "local"
+    assert u1.vc_report.residual_after < 1e-10
+
+
 def test_on_u1_the_local_correction_is_the_smoothed_gradient():
     r"""On a U1 basis (master derivatives at every member) the corrected
     derivatives are :math:`\int N_k \nabla N_i / V^k`: node-based

@@ -126,8 +126,9 @@ def under_integrated(basis):
     """The U1 basis on the families of ``basis``: WTE1 without bond
     correction — its derivatives are the master's for every member, so
     with the PBG weights (which sum to :math:`V^k`) every form integrates
-    :math:`V^k f(F^{kk})` — VC-corrected (V3, same boundary variant) if
-    ``basis`` is; ``basis`` itself if it already is one."""
+    :math:`V^k f(F^{kk})` — VC-corrected (V3, same boundary variant, VC
+    solver and tolerance) if ``basis`` is; ``basis`` itself if it already
+    is one."""
     if not isinstance(basis, FamilyBasis) or basis.is_petrov:
         raise ValueError("U1SUnl / U1SIG are built on a PBG FamilyBasis, "
                          "got {}".format(type(basis).__name__))
@@ -146,6 +147,8 @@ def under_integrated(basis):
                        shape="WTE1", bond=False,
                        vc=None if basis.vc is None else "V3",
                        vc_boundary=basis.vc_boundary, dim=basis.ncomp,
+                       vc_solver=basis.spec.vc_solver,
+                       vc_tolerance=basis.spec.vc_tolerance,
                        weight_exponent=basis.weight_exponent,
                        weights=basis.weights, **on_ranks)
 

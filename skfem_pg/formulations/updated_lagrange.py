@@ -48,10 +48,11 @@ from .displacement import Hyperelastic, internal_force, material_tangent
 
 
 def point_keys(basis):
-    """``k * n + j`` for each flat point (family ``k``, member particle
-    ``j``)."""
+    """``k * n + j`` for each flat point (master particle ``k`` of its
+    family, member particle ``j``): the same pair has the same key in
+    every basis on the particles, whichever particles master no family."""
     fam = basis.families
-    k = np.repeat(np.arange(len(fam.offsets) - 1), np.diff(fam.offsets))
+    k = np.repeat(np.asarray(fam.masters), np.diff(fam.offsets))
     return k * basis.particles.n + np.asarray(fam.members)
 
 
@@ -68,8 +69,8 @@ def remap_points(old, new, arrays):
     pos = np.minimum(pos, len(ko) - 1)
     hit = ko[order][pos] == kn
     src = order[pos]
-    fam = kn // n
-    master = np.searchsorted(ko[order], fam * n + fam)
+    k = kn // n
+    master = np.searchsorted(ko[order], k * n + k)
     src = np.where(hit, src, order[np.minimum(master, len(ko) - 1)])
     return [a[..., src] for a in arrays]
 
