@@ -138,12 +138,6 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
             "{} has global unknowns beyond the displacements: explicit "
             "steps on ranks take displacement models".format(
                 type(model).__name__))
-    if hasattr(model, "cells_to_fail"):  # crack-aware families
-        raise NotImplementedError(
-            "{}: crack-aware family updates rebuild the partition's "
-            "families; on ranks this version runs fracture with the "
-            "connectivity kept (a Hyperelastic model with a damage "
-            "material)".format(type(model).__name__))
     nc = n_u // len(part.local) if len(part.local) else 0
     if nc * len(part.local) != n_u or nc < 1:
         raise ValueError("the model is not on this partition's local "

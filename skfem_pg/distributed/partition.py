@@ -41,6 +41,7 @@ the tests) — many times slower than rank 0's solve
 (benchmarks/README.md, "Measurements behind the defaults"), so it is
 the choice only where rank 0's memory is the limit.
 """
+import copy
 import hashlib
 
 import numpy as np
@@ -52,6 +53,7 @@ from ..discretization import petrov
 from ..discretization.basis import FamilyBasis
 from ..discretization.families import Families
 from ..discretization.particles import Particles
+from ..errors import FamilyError, describe_particle
 from .comm import as_mpi, petsc
 from .vc import vc_correction
 
@@ -248,14 +250,35 @@ class Partition:
         mine &= self.particles.active
         return _subset(ring, mine)
 
-    def basis(self, families=None, **options):
+    def restricted(self, elements):
+        """This partition with its particles collocated from the cells
+        ``elements`` alone (a subset of its PG cells: the intact cells of
+        a crack, :mod:`~skfem_pg.formulations.crack_aware`): the same
+        owners and PETSc numbering; a vertex of no kept cell stays, with
+        zero volume.  Its :meth:`basis` with ``local=`` the first basis'
+        local particles shares that basis' dofs."""
+        cells = np.asarray(elements, dtype=np.int64)
+        pel = self.particles.elements
+        if pel is not None and not np.isin(cells, pel).all():
+            raise ValueError("restricted: cell {} is not one of the "
+                             "partition's PG cells".format(
+                                 cells[~np.isin(cells, pel)][0]))
+        sub = copy.copy(self)
+        sub.particles = Particles.from_mesh(self.mesh, elements=cells)
+        sub._area = None
+        return sub
+
+    def basis(self, families=None, local=None, **options):
         """This rank's :class:`~skfem_pg.FamilyBasis`: its owned families on
         its local particles (owned, then halo).  ``options`` are those of
         ``FamilyBasis`` (``shape``, ``bond``, ``vc``, ``dim``, ...);
         ``families``: global-numbered families of the owned masters
-        (default :meth:`families`).  Sets :attr:`local` (local → global
-        particle; a partition holds one local numbering, the last
-        basis') and returns the basis."""
+        (default :meth:`families`); ``local``: the local particles to
+        build on (default: the owned ones and the members of their
+        families; a basis rebuilt on fewer cells keeps the first one's,
+        and a member outside them raises :class:`FamilyError`).  Sets
+        :attr:`local` (local → global particle; a partition holds one
+        local numbering, the last basis') and returns the basis."""
         method = options.get("method", "PBG")
         if method not in ("PBG", "PPG1"):
             raise NotImplementedError(
@@ -291,10 +314,26 @@ class Partition:
         if np.any(self.owner[fam.masters] != self.rank):
             raise ValueError("a rank's basis holds the families of its "
                              "owned masters only")
-        halo = np.setdiff1d(np.union1d(fam.members,
-                                       self.mesh.t[:, self.fe_cells]),
-                            self.owned)
-        local = np.concatenate([self.owned, halo])
+        if local is None:
+            halo = np.setdiff1d(np.union1d(fam.members,
+                                           self.mesh.t[:, self.fe_cells]),
+                                self.owned)
+            local = np.concatenate([self.owned, halo])
+        else:
+            local = np.asarray(local, dtype=np.int64)
+            if not np.array_equal(local[:len(self.owned)], self.owned):
+                raise ValueError("local particles must start with the "
+                                 "rank's owned ones, in order")
+            outside = ~np.isin(fam.members, local)
+            if outside.any():
+                f = np.searchsorted(fam.offsets, np.flatnonzero(outside)[0],
+                                    side="right") - 1
+                j, k = fam.members[outside][0], fam.masters[f]
+                raise FamilyError(
+                    "the family of {} reaches {}, beyond the rank's local "
+                    "particles of the first basis".format(
+                        describe_particle(k, self.particles.x[:, k]),
+                        describe_particle(j, self.particles.x[:, j])))
         index = np.full(self.n, -1, dtype=np.int64)
         index[local] = np.arange(len(local))
         self.local = local

@@ -64,6 +64,15 @@ master):
   update, against 900 N mm stored).  The driver's energy balance does
   not depend on it (it counts the work of the forces).
 
+On MPI ranks (a basis from :meth:`Partition.basis
+<skfem_pg.distributed.Partition.basis>`) the failed points of each cell
+are counted over the ranks (:func:`failure_counts`, one reduction), so
+that every rank fails the same cells, and each rank rebuilds its part of
+the basis on the intact cells, on the local particles of the first one
+(:meth:`~skfem_pg.distributed.Partition.restricted`): the dofs, the
+halo exchange and the lumped mass stay.
+The rebuild of a ``vc_solver="local"`` basis needs no communication.
+
 The thesis' variant — connectivity kept — is the plain
 :class:`~skfem_pg.formulations.Hyperelastic` model on the same basis and
 material.  After an update :meth:`CrackAware.commit` returns ``True``, and
@@ -95,16 +104,26 @@ def cell_failure(basis, cells, failed, keys=None):
     vertices of the cell (``cells``: ``(n_vertices, n_cells)``);
     ``failed``: per flat point of ``basis``, or per point of ``keys``
     (:math:`k n + j`; U1SIG: its masters, :math:`k n + k`)."""
-    keys = point_keys(basis) if keys is None else np.asarray(keys)
+    keys = point_keys(basis) if keys is None else keys
+    bad, held = failure_counts(keys, basis.particles.n, cells, failed)
+    return bad / np.maximum(held, 1)
+
+
+def failure_counts(keys, n, cells, failed):
+    """``(failed, held)``: per cell, how many of the points ``keys``
+    (:math:`k n + j`, particles numbered ``0..n-1`` as the vertices of
+    ``cells``) it holds, and how many of them have ``failed`` (counts:
+    on MPI ranks they are summed over the ranks)."""
+    keys = np.asarray(keys)
     order = np.argsort(keys)
     sk = keys[order]
-    n = basis.particles.n
     q = (cells[:, None, :] * n + cells[None, :, :]).reshape(-1,
                                                           cells.shape[1])
-    pos = np.minimum(np.searchsorted(sk, q), len(sk) - 1)
-    hit = sk[pos] == q
-    bad = hit & np.asarray(failed, bool).ravel()[order[pos]]
-    return bad.sum(axis=0) / np.maximum(hit.sum(axis=0), 1)
+    pos = np.minimum(np.searchsorted(sk, q), max(len(sk) - 1, 0))
+    hit = sk[pos] == q if len(sk) else np.zeros(q.shape, bool)
+    bad = hit & np.asarray(failed, bool).ravel()[order[pos]] \
+        if len(sk) else hit
+    return bad.sum(axis=0), hit.sum(axis=0)
 
 
 def pieces(mesh, intact):
@@ -217,13 +236,16 @@ class _CrackHistory(History):
 
 
 def _check_crack_inputs(basis, material, fraction, what):
-    """Named errors for what crack-aware families cannot take."""
-    p = basis.particles
+    """Named errors for what crack-aware families cannot take (on a rank
+    of a :class:`~skfem_pg.distributed.Partition`, whose families follow
+    the mesh rule, the partition's particles are checked)."""
+    part = getattr(basis, "distributed", None)
+    p = basis.particles if part is None else part.particles
     if p.kind != "vertices" or p.mesh is None:
         raise ValueError("crack-aware families remove failed cells of "
                          "the collocation mesh: the particles must be "
                          "a mesh's vertices (Particles.from_mesh)")
-    if basis.options.get("families") != "mesh":
+    if part is None and basis.options.get("families") != "mesh":
         raise ValueError(
             "crack-aware families rebuild the families from the intact "
             "cells: the basis needs the 'mesh' family rule, got {!r}"
@@ -245,7 +267,13 @@ class _Crack:
     (the history and :math:`F_c` onto a new basis), :meth:`_set_basis`
     and :meth:`_n_points`."""
 
-    def _init_crack(self, particles, fraction, min_piece):
+    def _init_crack(self, basis, fraction, min_piece):
+        part = getattr(basis, "distributed", None)
+        #: on MPI ranks: the partition and the local particles of the
+        #: whole body's basis (every rebuild keeps them)
+        self._part = part
+        self._local = None if part is None else part.local.copy()
+        particles = basis.particles if part is None else part.particles
         self.material = _CrackHistory(self.material.material, self)
         self.fraction = float(fraction)
         d = particles.dim
@@ -265,7 +293,17 @@ class _Crack:
 
     @property
     def _mesh(self):
-        return self.basis.particles.mesh
+        return (self.basis.particles if self._part is None
+                else self._part).mesh
+
+    def _global(self, local):
+        """Particle numbers of the whole body (local ones on a rank)."""
+        return local if self._part is None else self._local[local]
+
+    def _total(self, count):
+        """A count summed over the ranks (as it is serially)."""
+        return count if self._part is None else \
+            self._part.comm.allreduce(count)
 
     # -- the crack ------------------------------------------------------
     def cells_to_fail(self, failed):
@@ -273,8 +311,18 @@ class _Crack:
         point of the history), debris included (module docstring)."""
         mesh = self._mesh
         idx = np.flatnonzero(self.intact)
-        share = cell_failure(self.basis, mesh.t[:, idx], failed,
-                             self._keys())
+        keys = self._keys()
+        n_local = self.basis.particles.n
+        keys = (self._global(keys // n_local) * mesh.p.shape[1]
+                + self._global(keys % n_local))
+        bad, held = failure_counts(keys, mesh.p.shape[1], mesh.t[:, idx],
+                                   failed)
+        if self._part is not None:  # every point lives on one rank
+            from mpi4py import MPI
+            both = np.stack([bad, held])
+            self._part.comm.Allreduce(MPI.IN_PLACE, both, op=MPI.SUM)
+            bad, held = both
+        share = bad / np.maximum(held, 1)
         fail = np.zeros_like(self.intact)
         fail[idx[share >= self.fraction - 1e-12]] = True
         if not fail.any():
@@ -283,9 +331,13 @@ class _Crack:
                                        self.min_piece)
 
     def _basis_on(self, intact):
-        """The basis of the model's options on the intact cells."""
-        particles = Particles.from_mesh(self._mesh,
-                                        elements=np.flatnonzero(intact))
+        """The basis of the model's options on the intact cells (on a
+        rank: its part of it, on the local particles of the first)."""
+        cells = np.flatnonzero(intact)
+        if self._part is not None:
+            return self._part.restricted(cells).basis(local=self._local,
+                                                      **self._options)
+        particles = Particles.from_mesh(self._mesh, elements=cells)
         return FamilyBasis(particles, **self._options)
 
     def update(self, u, F, fail):
@@ -332,8 +384,8 @@ class _Crack:
         vertex[mesh.t[:, cells].ravel()] = np.repeat(
             label[None], mesh.t.shape[0], axis=0).ravel()
         fam = new.families
-        k = np.repeat(fam.masters, fam.sizes)
-        bad = vertex[np.asarray(fam.members)] != vertex[k]
+        k = self._global(np.repeat(fam.masters, fam.sizes))
+        bad = vertex[self._global(np.asarray(fam.members))] != vertex[k]
         if bad.any():
             m = k[np.flatnonzero(bad)[0]]
             raise FamilyError(
@@ -363,7 +415,7 @@ class _Crack:
         failed = self.history.failed()
         if failed is None:
             return False
-        n = int(failed.sum())
+        n = self._total(int(failed.sum()))  # the ranks decide together
         if n == self._n_failed:
             return False
         self._n_failed = n
@@ -371,7 +423,7 @@ class _Crack:
         if not fail.any():
             return False
         self.update(state["u"], np.array(state[self._gradient_key]), fail)
-        self._n_failed = int(self.history.failed().sum())
+        self._n_failed = self._total(int(self.history.failed().sum()))
         return True
 
     def fracture_energy(self):
@@ -408,7 +460,7 @@ class CrackAware(_Crack, Hyperelastic):
         super().__init__(basis, material)
         self.current = basis
         self._options = basis.options
-        self._init_crack(basis.particles, fraction, min_piece)
+        self._init_crack(basis, fraction, min_piece)
 
     def _keys(self):
         return point_keys(self.current)
@@ -470,7 +522,7 @@ class CrackAwareU1SIG(_Crack, U1SIG):
         _check_crack_inputs(basis, material, fraction, "U1SIG")
         super().__init__(basis, material)
         self._options = self.u1.options
-        self._init_crack(basis.particles, fraction, min_piece)
+        self._init_crack(basis, fraction, min_piece)
 
     @classmethod
     def of(cls, basis, material):
