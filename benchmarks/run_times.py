@@ -153,6 +153,9 @@ SCRIPTS = [
     ("mpi_scaling", ["benchmarks/mpi_scaling.py"],
      "strong and weak scaling on 1 and 2 ranks against serial PG and H1 "
      "(sparse direct)", "minutes", 600),
+    ("explicit_scaling", ["benchmarks/explicit_scaling.py"],
+     "explicit central differences on 1 and 2 ranks: strong and weak "
+     "scaling, the serial driver beside them", "10 min", 600),
     ("local_vc", ["benchmarks/local_vc.py"],
      "local against global VC correction: manufactured rates, linear Cook "
      "2-D and 3-D against overkills (with H1, O1, O2), the correction's "
