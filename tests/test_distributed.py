@@ -552,7 +552,7 @@ def test_explicit_refusals_on_ranks():
         CrackAware(b, J2_DAMAGE)
 
 
-# -- crack-aware families on ranks ---------------------------------------------
+# -- crack-aware families on ranks --------------------------------------------
 def _notched_strip_run(kind, vc_solver, part=None, **kw):
     """The notched strip of ``test_fracture`` (4 x 8 cells) pulled apart
     with crack-aware families (Johnson–Cook damage), serial or on the
@@ -586,6 +586,51 @@ def _notched_strip_run(kind, vc_solver, part=None, **kw):
     return model, dist.central_difference(
         model, part, dist.lumped_mass(b, part, RHO), t_end, D=D, u_D=u_D,
         verbose=False, **kw)
+
+
+def test_restricted_basis_keeps_the_local_particles():
+    """``Partition.restricted(cells).basis(local=...)``: the basis on
+    fewer cells shares the first basis' dofs; a vertex of no kept cell
+    masters no family; local particles that do not start with the owned
+    ones, or miss a member, are refused by name."""
+    from skfem_pg.errors import FamilyError
+    mesh, _ = _plate(5)
+    part = dist.Partition(mesh, COMM)
+    b = part.basis(dim=2)
+    local = part.local.copy()
+    c = mesh.p[:, mesh.t].mean(axis=1)
+    keep = np.flatnonzero(~((c[0] < 0.25) & (c[1] < 0.25)))  # corner cut
+    sub = part.restricted(keep)
+    b2 = sub.basis(local=local, dim=2)
+    assert b2.N == b.N and np.array_equal(sub.local, local)
+    corner = np.flatnonzero((mesh.p[0] < 1e-9) & (mesh.p[1] < 1e-9))
+    masters = np.concatenate(COMM.allgather(local[b2.families.masters]))
+    assert corner[0] not in masters and len(masters) == part.n - 1
+    with pytest.raises(ValueError, match="PG cells"):
+        dist.Partition(mesh, COMM, elements=keep).restricted(
+            np.arange(mesh.nelements))
+    if len(part.owned) > 1:
+        with pytest.raises(ValueError, match="start with the rank's owned"):
+            sub.basis(local=local[::-1], dim=2)
+    if len(local) > len(part.owned):  # a halo: leave it out
+        with pytest.raises(FamilyError, match="beyond the rank's local"):
+            sub.basis(local=part.owned, dim=2)
+
+
+def test_an_error_on_one_rank_is_raised_on_every_rank():
+    """A basis that fails on rank 0 only (its local particles out of
+    order) raises there and, naming rank 0, on every other rank: no rank
+    is left waiting in the basis' collectives."""
+    mesh, _ = _plate(5)
+    part = dist.Partition(mesh, COMM)
+    part.basis(dim=2)
+    local = part.local.copy()
+    if COMM.rank == 0:
+        local[[0, 1]] = local[[1, 0]]
+    error = ValueError if COMM.rank == 0 else RuntimeError
+    with pytest.raises(error, match="start with the rank's owned"):
+        part.basis(local=local, dim=2)
+    assert COMM.allreduce(1) == COMM.size  # every rank got here
 
 
 @pytest.mark.parametrize("kind, vc_solver", [

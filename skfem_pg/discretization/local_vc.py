@@ -133,7 +133,7 @@ def family_shares(S, masters, mem, mask, x):
 
 def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
                         boundary="min-norm", index=None, shares=None,
-                        complete=None, **ignored):
+                        complete=None, together=None, **ignored):
     r"""Correct ``G`` family by family so each family meets its share of
     the integration constraint (module docstring).
 
@@ -146,7 +146,10 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     are those of the global constraint (5.18) with the FE-consistent
     ``area``; ``complete(sums)`` (default: ``sums - area.T`` and the
     active particles) turns this part's sums :math:`\sum_{kj} w_{kj}
-    G^{kji}` into the residual of all parts (a partition sums its ranks').
+    G^{kji}` into the residual of all parts (a partition sums its ranks');
+    ``together(error)`` (on ranks:
+    :func:`~skfem_pg.distributed.comm.raise_together`) raises an error of
+    one part's families on every part before the residual is summed.
     """
     if variant not in ("V3", "V5"):
         raise ValueError("local VC corrects with V3 or V5 (the bond "
@@ -167,6 +170,34 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         def complete(sums):
             return sums - area.T, volumes > 0
     r0, keep = complete(vc_residual(parts, [p[0] for p in parts], n))
+    Gc, error = None, None
+    try:  # an error of one part is raised on every part (ranks)
+        Gc = _corrected(parts, Qs, B, shares, volumes, x)
+    except Exception as err:  # noqa: BLE001 - raised below
+        error = err
+    if together is not None:
+        together(error)
+    elif error is not None:
+        raise error
+    r1, keep = complete(vc_residual(parts, Gc, n))
+    pairs = int(sum(p[2].padded()[1].sum() for p in parts))  # (k, i)
+    rep = VCReport(
+        variant=variant, solver="local", unknowns=pairs * d,
+        constraints=pairs * d,
+        residual_before=float(np.abs(r0[keep]).max() / area_scale),
+        residual_after=float(np.abs(r1[keep]).max() / area_scale),
+        iterations=0, seconds=time.perf_counter() - t0,
+        notes=["local: one d x d solve per family"], boundary=boundary,
+        particle_residuals=np.abs(r1 * keep[:, None]).max(axis=1)
+        / area_scale)
+    return (Gc if grouped else Gc[0]), rep
+
+
+def _corrected(parts, Qs, B, shares, volumes, x):
+    """The corrected derivatives of each group of ``parts``
+    (:func:`local_vc_correction`): per family one ``d x d`` solve for
+    :math:`\beta^{ki}`, then :math:`C^{kji} = Q^{kj}\beta^{ki}`."""
+    d = x.shape[0]
     Gc = []
     for (Gp, w, f, _, idx), Q in zip(parts, Qs):
         mem, mask = f.padded()
@@ -188,18 +219,7 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         # C^{kji} = Q^{kj} beta^{ki} at the real members j
         C = np.matmul(Q, np.swapaxes(beta, 1, 2)[:, None])  # (k, j, a, i)
         Gc.append(Gp + np.swapaxes(C, 2, 3) * mask[:, :, None, None])
-    r1, keep = complete(vc_residual(parts, Gc, n))
-    pairs = int(sum(p[2].padded()[1].sum() for p in parts))  # (k, i)
-    rep = VCReport(
-        variant=variant, solver="local", unknowns=pairs * d,
-        constraints=pairs * d,
-        residual_before=float(np.abs(r0[keep]).max() / area_scale),
-        residual_after=float(np.abs(r1[keep]).max() / area_scale),
-        iterations=0, seconds=time.perf_counter() - t0,
-        notes=["local: one d x d solve per family"], boundary=boundary,
-        particle_residuals=np.abs(r1 * keep[:, None]).max(axis=1)
-        / area_scale)
-    return (Gc if grouped else Gc[0]), rep
+    return Gc
 
 
 def local_solver(particles, distributed=None):
@@ -224,6 +244,7 @@ def local_solver(particles, distributed=None):
                 S.extend(smoothed_gradients(mesh, particles.elements))
             return family_shares(S, masters, mem, mask, x)
         return functools.partial(local_vc_correction, shares=shares)
+    from ..distributed.comm import raise_together
     part = distributed
     glob = part.particles
     S = []
@@ -238,5 +259,6 @@ def local_solver(particles, distributed=None):
 
     def complete(sums):
         return part.sum_particles(sums) - A.T, glob.active
-    return functools.partial(local_vc_correction, shares=shares,
-                             complete=complete)
+    return functools.partial(
+        local_vc_correction, shares=shares, complete=complete,
+        together=functools.partial(raise_together, part.comm))

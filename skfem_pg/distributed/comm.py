@@ -62,3 +62,18 @@ def as_mpi(comm=None):
         return comm
     raise TypeError("comm must be an mpi4py or petsc4py communicator, got "
                     "{}".format(type(comm).__name__))
+
+
+def raise_together(comm, error):
+    """Raise on every rank of ``comm`` when one rank has an ``error`` (an
+    exception, or ``None``): that rank raises its own, the others a
+    ``RuntimeError`` naming it.  Call it where ranks are about to enter a
+    collective the failing rank would never reach, so that none is left
+    waiting (one ``allgather`` of the messages)."""
+    messages = comm.allgather(None if error is None else "{}: {}".format(
+        type(error).__name__, error))
+    if error is not None:
+        raise error
+    for rank, message in enumerate(messages):
+        if message is not None:
+            raise RuntimeError("rank {} failed: {}".format(rank, message))

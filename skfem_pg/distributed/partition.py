@@ -54,7 +54,7 @@ from ..discretization.basis import FamilyBasis
 from ..discretization.families import Families
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
-from .comm import as_mpi, petsc
+from .comm import as_mpi, petsc, raise_together
 from .vc import vc_correction
 
 #: cell rings around the owned particles from which their families are
@@ -309,31 +309,14 @@ class Partition:
             raise NotImplementedError(
                 "weights={!r} on MPI: the distributed basis integrates with "
                 "the volume weights (4.30)".format(options["weights"]))
-        fam = (self.families(pairwise=method == "PPG1") if families is None
-               else families)
-        if np.any(self.owner[fam.masters] != self.rank):
-            raise ValueError("a rank's basis holds the families of its "
-                             "owned masters only")
-        if local is None:
-            halo = np.setdiff1d(np.union1d(fam.members,
-                                           self.mesh.t[:, self.fe_cells]),
-                                self.owned)
-            local = np.concatenate([self.owned, halo])
-        else:
-            local = np.asarray(local, dtype=np.int64)
-            if not np.array_equal(local[:len(self.owned)], self.owned):
-                raise ValueError("local particles must start with the "
-                                 "rank's owned ones, in order")
-            outside = ~np.isin(fam.members, local)
-            if outside.any():
-                f = np.searchsorted(fam.offsets, np.flatnonzero(outside)[0],
-                                    side="right") - 1
-                j, k = fam.members[outside][0], fam.masters[f]
-                raise FamilyError(
-                    "the family of {} reaches {}, beyond the rank's local "
-                    "particles of the first basis".format(
-                        describe_particle(k, self.particles.x[:, k]),
-                        describe_particle(j, self.particles.x[:, j])))
+        fam = error = None
+        try:  # an error here is raised on every rank (no rank left waiting)
+            fam = (self.families(pairwise=method == "PPG1")
+                   if families is None else families)
+            local = self._local_particles(fam, local)
+        except Exception as err:  # noqa: BLE001 - raised on every rank
+            error = err
+        raise_together(self.comm, error)
         index = np.full(self.n, -1, dtype=np.int64)
         index[local] = np.arange(len(local))
         self.local = local
@@ -352,6 +335,34 @@ class Partition:
         basis = FamilyBasis(lp, lfam, distributed=self, **options)
         self.ncomp = 1 if basis.ncomp is None else int(basis.ncomp)
         return basis
+
+    def _local_particles(self, fam, local=None):
+        """The local particles of a basis of the families ``fam``: owned,
+        then halo (the members of ``fam`` and the vertices of the FE cells
+        owned elsewhere), or ``local`` checked."""
+        if np.any(self.owner[fam.masters] != self.rank):
+            raise ValueError("a rank's basis holds the families of its "
+                             "owned masters only")
+        if local is None:
+            halo = np.setdiff1d(np.union1d(fam.members,
+                                           self.mesh.t[:, self.fe_cells]),
+                                self.owned)
+            return np.concatenate([self.owned, halo])
+        local = np.asarray(local, dtype=np.int64)
+        if not np.array_equal(local[:len(self.owned)], self.owned):
+            raise ValueError("local particles must start with the "
+                             "rank's owned ones, in order")
+        outside = ~np.isin(fam.members, local)
+        if outside.any():
+            f = np.searchsorted(fam.offsets, np.flatnonzero(outside)[0],
+                                side="right") - 1
+            j, k = fam.members[outside][0], fam.masters[f]
+            raise FamilyError(
+                "the family of {} reaches {}, beyond the rank's local "
+                "particles of the first basis".format(
+                    describe_particle(k, self.particles.x[:, k]),
+                    describe_particle(j, self.particles.x[:, j])))
+        return local
 
     def fe_basis(self, element):
         """This rank's scikit-fem basis of ``element`` on its FE cells, on

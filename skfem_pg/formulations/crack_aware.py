@@ -70,8 +70,8 @@ are counted over the ranks (:func:`failure_counts`, one reduction), so
 that every rank fails the same cells, and each rank rebuilds its part of
 the basis on the intact cells, on the local particles of the first one
 (:meth:`~skfem_pg.distributed.Partition.restricted`): the dofs, the
-halo exchange and the lumped mass stay.
-The rebuild of a ``vc_solver="local"`` basis needs no communication.
+halo exchange and the lumped mass stay.  The rebuild of a
+``vc_solver="local"`` basis needs no communication.
 
 The thesis' variant — connectivity kept — is the plain
 :class:`~skfem_pg.formulations.Hyperelastic` model on the same basis and
