@@ -727,11 +727,14 @@ def test_local_vc_patch_test_on_ranks(dim):
 @pytest.mark.parametrize("formulation, material", [
     ("UnlP0", NeoHookeIsoVol(MU, LAM + 2 * MU / 3)),
     ("UnlP0", J2Plasticity(LAM, MU, 20.0)),
+    ("U1SUnl", J2Plasticity(LAM, MU, 20.0)),
     ("U1SIG", J2Plasticity(LAM, MU, 20.0))])
 def test_condensed_mixed_newton_equals_serial(formulation, material):
-    """UnlP0 (a pressure and dilatation per family, condensed) and U1SIG
-    (the stabilization at the masters) in the distributed Newton, elastic
-    and plastic (history per rank): the serial solution to round-off."""
+    """UnlP0 (a pressure and dilatation per family, condensed), U1SUnl
+    (its U1 basis and the full-integration stabilization, both on the
+    rank) and U1SIG (the stabilization at the masters) in the distributed
+    Newton, elastic and plastic (history per rank): the serial solution
+    to round-off."""
     mesh, f, D = cantilever3d(4)
     load = 0.5 * f  # tip 0.19, max e_p 0.11 (UnlP0), 0.024 (U1SIG)
     ms = model_for(formulation, pg.FamilyBasis(mesh, dim=3), material)
