@@ -194,7 +194,7 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
 
 
 def _corrected(parts, Qs, B, shares, volumes, x):
-    """The corrected derivatives of each group of ``parts``
+    r"""The corrected derivatives of each group of ``parts``
     (:func:`local_vc_correction`): per family one ``d x d`` solve for
     :math:`\beta^{ki}`, then :math:`C^{kji} = Q^{kj}\beta^{ki}`."""
     d = x.shape[0]
