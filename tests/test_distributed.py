@@ -484,6 +484,21 @@ def test_explicit_fe_equals_serial(element):
     assert_runs_agree(td, ts)
 
 
+def _killed_at(call):
+    """``(Stop, callback)``: the callback raises ``Stop`` at its
+    ``call``-th call (a run killed in the middle)."""
+    class Stop(Exception):
+        pass
+
+    count = [0]
+
+    def kill(*args):
+        count[0] += 1
+        if count[0] == call:
+            raise Stop
+    return Stop, kill
+
+
 def test_explicit_checkpoint_restart_on_ranks():
     """Killed at step 60 of a run writing every 25 steps: every rank
     wrote its piece of step 50, rank 0 the manifest; the resumed run ends
@@ -502,16 +517,7 @@ def test_explicit_checkpoint_restart_on_ranks():
     root = COMM.bcast(tempfile.mkdtemp() if COMM.rank == 0 else None)
     path = os.path.join(root, "drop")
 
-    class Stop(Exception):
-        pass
-
-    count = [0]
-
-    def kill(*args):
-        count[0] += 1
-        if count[0] == 61:
-            raise Stop
-
+    Stop, kill = _killed_at(61)
     with pytest.raises(Stop):
         dist.central_difference(model_for("UnlP0", b, J2), part, m, T_END,
                                 v0=v0, wall=_wall(), verbose=False,
@@ -669,16 +675,7 @@ def test_crack_aware_checkpoint_after_an_update_on_ranks():
     root = COMM.bcast(tempfile.mkdtemp() if COMM.rank == 0 else None)
     path = os.path.join(root, "crack")
 
-    class Stop(Exception):
-        pass
-
-    count = [0]
-
-    def kill(*args):
-        count[0] += 1
-        if count[0] == 221:
-            raise Stop
-
+    Stop, kill = _killed_at(221)
     with pytest.raises(Stop):
         _notched_strip_run("Unl", "local", part, callback=kill,
                            output_every=1,

@@ -115,14 +115,15 @@ def failure_counts(keys, n, cells, failed):
     ``cells``) it holds, and how many of them have ``failed`` (counts:
     on MPI ranks they are summed over the ranks)."""
     keys = np.asarray(keys)
+    if keys.size == 0:  # a rank without points
+        return (np.zeros(cells.shape[1], int),) * 2
     order = np.argsort(keys)
     sk = keys[order]
     q = (cells[:, None, :] * n + cells[None, :, :]).reshape(-1,
                                                           cells.shape[1])
-    pos = np.minimum(np.searchsorted(sk, q), max(len(sk) - 1, 0))
-    hit = sk[pos] == q if len(sk) else np.zeros(q.shape, bool)
-    bad = hit & np.asarray(failed, bool).ravel()[order[pos]] \
-        if len(sk) else hit
+    pos = np.minimum(np.searchsorted(sk, q), len(sk) - 1)
+    hit = sk[pos] == q
+    bad = hit & np.asarray(failed, bool).ravel()[order[pos]]
     return bad.sum(axis=0), hit.sum(axis=0)
 
 
@@ -311,12 +312,11 @@ class _Crack:
         point of the history), debris included (module docstring)."""
         mesh = self._mesh
         idx = np.flatnonzero(self.intact)
-        keys = self._keys()
-        n_local = self.basis.particles.n
-        keys = (self._global(keys // n_local) * mesh.p.shape[1]
-                + self._global(keys % n_local))
-        bad, held = failure_counts(keys, mesh.p.shape[1], mesh.t[:, idx],
-                                   failed)
+        keys, n = self._keys(), mesh.p.shape[1]
+        if self._part is not None:  # in the whole body's numbering
+            k, j = np.divmod(keys, self.basis.particles.n)
+            keys = self._local[k] * n + self._local[j]
+        bad, held = failure_counts(keys, n, mesh.t[:, idx], failed)
         if self._part is not None:  # every point lives on one rank
             from mpi4py import MPI
             both = np.stack([bad, held])
