@@ -138,6 +138,10 @@ SCRIPTS = [
      "the thesis recipe against kNN, O1, O2 (H1 on hex grids): Cook, "
      "cantilever, plate with a hole, linear, against O2/H2 overkills",
      "10 min", 600),
+    ("recipes_2d", ["benchmarks/recipes_2d.py"],
+     "2-D recipes (family rule, weights, bond weight exponent) against "
+     "T1/Q1: four elastic geometries on triangles and quadrilaterals, "
+     "Poisson, against T2 overkills", "6 min", 360),
     ("infsup_mixed", ["benchmarks/infsup_mixed.py"],
      "inf-sup values of the mixed PG pairs beside Q1P0, MINI (thesis Fig. "
      "7.15)", "1 min", 60),

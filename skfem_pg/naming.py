@@ -1,7 +1,7 @@
 r"""Thesis names of formulations (Table 7.1) <-> ``FamilyBasis`` options.
 
 A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
-{formulation} [TL|UL] [noBC] [kNN]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
+{formulation} [TL|UL] [noBC] [kNN|meshU]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
 ``FEM {T1|Q1|O1|H1|Q1P0|H1P0|T2|Q2|O2|H2}`` for the FE comparators:
 
 ==========  ==============================================================
@@ -31,6 +31,10 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
             mesh families, volume weights (4.30) and
             :math:`\omega = 1/|\Delta X|^2` — the keyword API's default
             for PBG Unl on 3-D tetrahedra
+``meshU``   a package token: the ``meshU`` recipe (the thesis' mesh
+            families with uniform quadrature weights and unit bond
+            weights) — the keyword API's default for PBG Unl on 2-D
+            triangles
 ==========  ==============================================================
 
 So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
@@ -52,13 +56,14 @@ built, naming it).
 import re
 
 from . import registry
+from .discretization import recipes
 
 # the formulation tokens (their shape functions, kinds, the UL frame) and
 # the FE comparators are those of skfem_pg.registry
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
                    r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
-                   r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN))?$")
+                   r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN|meshU))?$")
 _BOUNDARY = {"p": "p", "s": "s", "sn": "sn", "m": "min-norm"}
 
 
@@ -140,9 +145,12 @@ def parse(name):
           "bond": first_order and not g["nobc"] and not record.master_only}
     if g["recipe"]:
         if method != "PBG" or shape != "MTE1":
-            raise ValueError("{!r}: the kNN recipe (uniform quadrature "
-                             "weights) is for PBG on MTE1 bases".format(name))
-        kw.update(families="nearest", weights="uniform", weight_exponent=0)
+            raise ValueError("{!r}: the {} recipe (uniform quadrature "
+                             "weights) is for PBG on MTE1 bases".format(
+                                 name, g["recipe"]))
+        families, weights, exponent = recipes.RECIPES[g["recipe"]]
+        kw.update(families=families, weights=weights,
+                  weight_exponent=exponent)
     else:  # the thesis' families (WTE2: its horizon) and weights
         if shape != "WTE2":
             kw["families"] = "mesh"
@@ -205,6 +213,6 @@ def name_of(basis):
     if vc:
         variant += {v: k for k, v in _BOUNDARY.items()}[basis.vc_boundary]
     tail = " noBC" if first_order and not basis.bond else ""
-    if getattr(basis, "recipe", None) == "kNN":
-        tail += " kNN"
+    if getattr(basis, "recipe", None) in ("kNN", "meshU"):
+        tail += " " + basis.recipe
     return "{}{}{} {} TL{}".format(prefix, method, variant, form, tail)

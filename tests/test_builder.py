@@ -16,8 +16,8 @@ def particles():
 def test_spec_resolves_defaults_once(particles):
     s = BasisSpec.resolve(particles, dim=2)
     assert (s.shape, s.bond, s.vc, s.method, s.weights, s.weight_exponent,
-            s.families, s.recipe) == ("MTE1", True, "V5", "PBG", "volume",
-                                      1.0, "mesh", "mesh")
+            s.families, s.recipe) == ("MTE1", True, "V5", "PBG", "uniform",
+                                      0.0, "mesh", "meshU")  # triangles
     assert s.grouped  # the default runs per size group, unpadded
     p = BasisSpec.resolve(particles, dim=2, method="PPG1")
     assert (p.vc, p.grouped) == ("V3", False)
@@ -41,8 +41,12 @@ def test_from_spec_is_the_keyword_constructor(particles, kw):
 
 def test_name_parser_produces_the_spec(particles):
     s, notes = BasisSpec.from_name(particles, "VCBCPBG V5 Unl", dim=2)
+    # a thesis name means the thesis' recipe, whatever the keyword default
     assert s == BasisSpec.resolve(particles, dim=2, shape="MTE1", bond=True,
-                                  vc="V5", vc_boundary="sn")
+                                  vc="V5", vc_boundary="sn", families="mesh")
+    assert (s.weights, s.weight_exponent) == ("volume", 1.0)
+    u, _ = BasisSpec.from_name(particles, "VCBCPBG V5m Unl TL meshU", dim=2)
+    assert u == BasisSpec.resolve(particles, dim=2)  # the 2-D tri default
     assert s.vc_boundary == "sn"  # the thesis' boundary variant
     b = pg.FamilyBasis.from_name(particles, "VCBCPPG V3sn Unl TL", dim=2)
     assert b.spec.method == "PPG1" and b.name == "VCBCPPG V3sn Unl TL"

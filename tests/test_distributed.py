@@ -104,6 +104,34 @@ def test_linear_elasticity_equals_serial(kw):
     assert info["iterations"] < 100  # CG + GAMG with rigid-body modes
 
 
+@pytest.mark.parametrize("kind, recipe", [("tri", "meshU"),
+                                          ("tet", "kNN")])
+def test_default_recipe_on_ranks_equals_serial(kind, recipe):
+    """The keyword default's recipe on ranks (issue 45): 2-D triangles
+    take ``meshU`` (uniform weights, unit bond weights), 3-D tetrahedra
+    ``kNN`` (nearest families with ties, from the replicated positions),
+    as serial :class:`~skfem_pg.FamilyBasis` does."""
+    if kind == "tri":
+        mesh, elem = square(8, 0.3, seed=3, kind="tri"), fem.ElementTriP1()
+    else:
+        mesh, elem = cube(4, 0.2, seed=4, kind="tet"), fem.ElementTetP1()
+    d = mesh.dim()
+    e = fem.ElementVector(elem)
+    fb = fem.FacetBasis(mesh, e, facets=mesh.facets_satisfying(
+        lambda x: np.isclose(x[0], 1)))
+    f = fem.LinearForm(lambda v, w: 1.0 * v[1] + 0.5 * v[0]).assemble(fb)
+    D = fem.Basis(mesh, e).get_dofs(
+        lambda x: np.isclose(x[0], -1 if kind == "tri" else 0)).all()
+    sb = pg.FamilyBasis(mesh, dim=d)
+    assert sb.recipe == recipe
+    u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
+    part = dist.Partition(mesh, COMM)
+    basis = part.basis(dim=d)
+    assert (basis.weights, basis.weight_exponent) == ("uniform", 0)
+    u, _ = dist.solve(pg.assemble(FORM, basis), part, f, D=D)
+    assert rel(u, u_s) <= 1e-10
+
+
 def test_options_string_reaches_the_ksp():
     mesh, f, D = cantilever3d(3)
     sb = pg.FamilyBasis(mesh, dim=3)

@@ -1,6 +1,7 @@
 """The kNN recipe (nearest-neighbour families, uniform quadrature weights,
-unit bond weights; the keyword default of PBG Unl on 3-D tetrahedra) keeps
-every guarantee of the thesis' recipe: the linear patch test, exactly the
+unit bond weights; the keyword default of PBG Unl on 3-D tetrahedra) and
+the meshU recipe (mesh families, uniform weights, unit bond weights; the
+default on 2-D triangles) keep every guarantee of the thesis' recipe: the linear patch test, exactly the
 rigid-body zero modes, and convergence rates of at least 2 (L2) and 1
 (H1); near-singular families are repaired or refused."""
 import numpy as np
@@ -29,6 +30,14 @@ def test_defaults_by_mesh_kind():
     assert default_recipe(tets, shape="WTE1") == "mesh"
     assert default_recipe(pg.Particles.from_mesh(cube(2))) == "mesh"
     assert default_recipe(pg.Particles.from_mesh(square(3))) == "mesh"
+    tris = pg.Particles.from_mesh(square(3, kind="tri"))
+    assert default_recipe(tris) == "meshU"
+    assert default_recipe(tris, method="PPG1") == "mesh"
+    b = pg.FamilyBasis(tris, dim=2)
+    assert (b.recipe, b.weights, b.weight_exponent) == ("meshU", "uniform",
+                                                        0)
+    assert b.options["families"] == "mesh"
+    assert pg.FamilyBasis(tris, dim=2, families="mesh").weights == "volume"
     b = pg.FamilyBasis(tets, dim=3)
     assert (b.recipe, b.weights, b.weight_exponent) == ("kNN", "uniform", 0)
     assert b.options["families"] == "nearest"  # what UL rebuilds with
@@ -45,6 +54,20 @@ def test_defaults_by_mesh_kind():
 def test_patch_test_3d(mesh):
     r = linear_patch_test(mesh(), lambda x: np.isclose(x[0], 1.0))
     assert r["basis"].recipe == "kNN"
+    assert r["max_error"] < 1e-10 and r["H1"] < 1e-10
+
+
+@pytest.mark.parametrize("mesh", [
+    pytest.param(lambda: pg.meshing.from_geo(pg.meshing.geo_path(
+        "square.geo"), size=0.15), id="gmsh"),
+    pytest.param(lambda: square(8, 0.3, seed=4, kind="tri"),
+                 id="distorted"),
+])
+def test_patch_test_2d_triangles_default(mesh):
+    m = mesh()
+    x0 = m.p[0].max()
+    r = linear_patch_test(m, lambda x: np.isclose(x[0], x0))
+    assert r["basis"].recipe == "meshU"
     assert r["max_error"] < 1e-10 and r["H1"] < 1e-10
 
 
@@ -91,6 +114,23 @@ def test_exactly_the_rigid_body_zero_modes(dim):
     assert pgev[rigid] > 0.5 * feev[rigid]
 
 
+@pytest.mark.parametrize("mesh", [
+    pytest.param(lambda: square(10, 0.3, seed=5, kind="tri"),
+                 id="distorted"),
+    pytest.param(lambda: pg.meshing.from_geo(pg.meshing.geo_path(
+        "cook.geo"), size=6.0), id="gmsh-cook"),
+])
+def test_meshu_has_exactly_the_rigid_body_zero_modes(mesh):
+    """The 2-D triangle default (meshU): 3 zero eigenvalues of the free
+    body and the first deformation frequency above half of T1's."""
+    m = mesh()
+    basis = pg.FamilyBasis(m, dim=2)
+    assert basis.recipe == "meshU"
+    pgev, feev = free_spectrum(basis, m, fem.ElementTriP1())
+    assert np.sum(np.abs(pgev) < 1e-10 * pgev[-1]) == 3
+    assert pgev[3] > 0.5 * feev[3]
+
+
 @pytest.mark.study
 def test_manufactured_rates_3d():
     """L2 and H1 rates on unstructured gmsh tetrahedra (144 ... 1879
@@ -109,6 +149,17 @@ def test_manufactured_rates_2d_nearest():
     runs = [solve_manufactured(square(n, 0.3, seed=n, kind="tri"), field,
                                1.0, 1.0, families="nearest")
             for n in (8, 16, 32)]
+    h = [r["h"] for r in runs]
+    l2, _ = rates(h, [r["L2"] for r in runs])
+    h1, _ = rates(h, [r["H1"] for r in runs])
+    assert l2 >= 2.0 and h1 >= 1.0
+
+
+def test_manufactured_rates_2d_triangles_default():
+    """meshU on ±0.3h distorted triangles (81 ... 1089 nodes)."""
+    field = PlaneWaves(2)
+    runs = [solve_manufactured(square(n, 0.3, seed=n, kind="tri"), field,
+                               1.0, 1.0) for n in (8, 16, 32)]
     h = [r["h"] for r in runs]
     l2, _ = rates(h, [r["L2"] for r in runs])
     h1, _ = rates(h, [r["H1"] for r in runs])

@@ -75,9 +75,11 @@ class FamilyBasis(AbstractBasis):
         :class:`~skfem_pg.discretization.families.Families`, or a rule of
         :data:`~skfem_pg.discretization.families.RULES`: ``"mesh"`` (mesh
         connectivity), ``"nearest"`` (the 10 (3-D) / 6 (2-D) nearest
-        particles, pairwise) or ``"horizon"`` (1.51 h).  Default: the
+        particles and those as near as the last, pairwise) or ``"horizon"`` (1.51 h).  Default: the
         recipe of :mod:`~skfem_pg.discretization.recipes` — ``"nearest"``
         for PBG MTE1 on 3-D tetrahedra (recipe ``kNN``), else ``"mesh"``
+        (on 2-D triangles with uniform weights and unit bond weights,
+        recipe ``meshU``)
         for mesh particles and a horizon of 1.51 h otherwise; for WTE2 a
         horizon of 2.51 h, small families enlarged to one member more
         than the quadratic basis needs.
@@ -86,7 +88,8 @@ class FamilyBasis(AbstractBasis):
         (:mod:`~skfem_pg.discretization.quadrature`): ``"volume"``
         (:math:`V^k V^j / V_H^k`, (4.30)) or ``"uniform"``
         (:math:`V^k / n_k`).  Default (``"auto"``): the recipe's —
-        ``"uniform"`` with ``"nearest"`` families, else ``"volume"``.
+        ``"uniform"`` for the default families on 2-D triangles and 3-D
+        tetrahedra and with ``"nearest"`` families, else ``"volume"``.
         PPG has its own weights (:math:`V^j`).
     shape
         ``"MTE1"`` (moving Taylor expansion, formulation Unl; default),
@@ -122,8 +125,8 @@ class FamilyBasis(AbstractBasis):
         Poisson), the spatial dimension for displacements.
     weight_exponent
         ``n`` in :math:`\\omega = 1/|\\Delta X|^{2n}`, ``n >= 0``.
-        Default (``"auto"``): the recipe's — 0 with ``"nearest"``
-        families, else 1.
+        Default (``"auto"``): the recipe's — 0 where the weights are
+        ``"uniform"`` by default, else 1.
     vc_solver
         Solver of the VC constraint system: ``"auto"`` (``"direct"``, in
         3-D above 15k particles ``"amg"``), ``"direct"`` (scalar sparse

@@ -295,9 +295,27 @@ def horizon(particles, delta=None, factor=1.51, min_size=None):
                      d + 2 if min_size is None else min_size)
 
 
-def nearest(particles, n, pairwise=True, min_size=None):
+def nearest(particles, n, pairwise=True, min_size=None, ties=True,
+            tie_tolerance=1e-6):
     """Families of the ``n`` nearest neighbours of each particle, made
-    pairwise (``j`` in ``H^k`` whenever ``k`` in ``H^j``) by default."""
+    pairwise (``j`` in ``H^k`` whenever ``k`` in ``H^j``) by default.
+
+    ``ties``: every particle as near as the ``n``-th nearest (within
+    ``tie_tolerance`` times its distance) joins too, so that the families
+    of a regular grid keep its symmetry (on a square grid ``n = 6``
+    gives the 3 x 3 stencil, not 4 edge and 2 of the 4 corner
+    neighbours picked by the KD-tree's internal order); ``ties=False``
+    takes exactly ``n`` (the order among equidistant particles is then
+    arbitrary).
+
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> m = fem.MeshQuad.init_tensor(*(2 * [range(5)]))
+    >>> p = pg.Particles.from_mesh(m)
+    >>> f = pg.families.nearest(p, 6, pairwise=False)
+    >>> centre = int(np.argmin(np.hypot(*(p.x - 2.0))))
+    >>> int(f.sizes[f.masters == centre][0])  # the 3 x 3 stencil
+    9
+    """
     act, tree = _active_tree(particles)
     if isinstance(n, (bool, np.bool_)) or not isinstance(
             n, (int, np.integer)):
@@ -306,9 +324,22 @@ def nearest(particles, n, pairwise=True, min_size=None):
     if n < 1 or n >= len(act):
         raise FamilyError("need 1 <= n < {} (active particles), got {}"
                           .format(len(act), n))
-    _, idx = tree.query(particles.x[:, act].T, k=n + 1)
-    rows = np.repeat(act, n + 1)
-    cols = act[idx.ravel()]
+    tol = _positive_number(tie_tolerance, "tie tolerance") if ties else 0.0
+    pts = particles.x[:, act].T
+    k = n + 1
+    while True:  # at most log2(#particles) rounds: k doubles
+        kq = min(len(act), 2 * k if ties else k)
+        dist, idx = tree.query(pts, k=kq)
+        dist, idx = dist.reshape(len(act), kq), idx.reshape(len(act), kq)
+        if not ties:
+            keep = np.ones(dist.shape, dtype=bool)
+            break
+        keep = dist <= dist[:, n:n + 1] * (1.0 + tol)
+        if kq == len(act) or not keep[:, -1].any():
+            break  # every tie found: the last column is beyond them
+        k = kq
+    rows = np.repeat(act, keep.sum(axis=1))
+    cols = act[idx[keep]]
     N = particles.n
     A = sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, cols)),
                       shape=(N, N))

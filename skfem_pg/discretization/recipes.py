@@ -16,10 +16,13 @@ A recipe is three choices made together, because they act together:
 =========  ===============================================  ===================
 recipe     families, weights, exponent                      default for
 =========  ===============================================  ===================
-``mesh``   ``"mesh"``, ``"volume"``, 1 (the thesis')        2-D; hexahedra;
+``mesh``   ``"mesh"``, ``"volume"``, 1 (the thesis')        quadrilaterals;
+                                                            hexahedra;
                                                             PPG, WTE1/WTE2;
                                                             particles w/o mesh
                                                             (``"horizon"``)
+``meshU``  ``"mesh"``, ``"uniform"``, 0                     PBG MTE1 on 2-D
+                                                            triangles
 ``kNN``    ``"nearest"`` (10, pairwise), ``"uniform"``, 0   PBG MTE1 on 3-D
                                                             tetrahedra
 =========  ===============================================  ===================
@@ -41,18 +44,35 @@ weights use the few members evenly.  Each choice alone helps little
 with volume weights: +5.1 %, stalling there); together they converge from
 below like FE: −18 / −3.1 / −1.7 / +0.4 / −0.03 % on the same node sets
 (the tables ``recipes_3d_*`` in ``benchmarks/README.md``, written by
-``benchmarks/recipes_3d.py``).  On hexahedral grids (at most 27 regularly
-placed members) and in 2-D the thesis recipe was measured the more
-accurate on the geometries of ``recipes_3d`` and stays the default; in
-bending on coarse node sets it is soft there too (a 5 × 1 × 1 hexahedral
-beam, 525 nodes: tip +38 %, ``kNN`` −2.0 %, H1 −3.4 %,
+``benchmarks/recipes_3d.py``).
+
+Why ``meshU`` on triangles.  The same two weight choices on the 1-ring
+families of a 2-D triangle mesh (issue 45; ``benchmarks/recipes_2d.py``,
+tables ``recipes_2d_*`` in ``benchmarks/README.md``): in plane strain
+against T2 overkills, compliance errors at about 3,000 nodes (+ = soft)
+of +0.16 % (curved cantilever), +0.19 % (straight cantilever), −0.64 %
+(L bracket) and −0.01 % (plate with an elliptic hole, tension), against
+T1's −0.64 / −0.53 / −1.45 / −0.18 % and the thesis recipe's +0.79 /
++0.94 / +0.56 / +0.07 %: 0.06–0.44 times T1's error, the same sign at
+every refinement.  On Poisson problems it is stiff: −0.16 / −0.35 /
+−0.43 % (square, L bracket, disk) against P1's −0.11 / −0.42 / −0.12 %.
+The nearest-neighbour families, with or without equidistant ties, are
+no better there and change sign under refinement.
+
+On quadrilaterals and hexahedral grids no recipe of the study is
+robustly better than the thesis' (its tables: on gmsh quadrilaterals
+the best variant per geometry is 0.14–1.6 times Q1's error, and the
+winner changes with the geometry; on mapped quadrilaterals of the
+curved cantilever all are worse than Q1), so ``mesh`` stays their
+default; in bending on coarse node sets it is soft (a 5 × 1 × 1
+hexahedral beam, 525 nodes: tip +38 %, H1 −3.4 %,
 ``tests/test_gallery.py``; the plane-strain cantilever of
-``docs/examples/ex02_cantilever.py``, 297 nodes: +6.5 %, ``kNN`` −2.8 %,
-Q1 −2.2 %), which a change of default would have to weigh.
+``docs/examples/ex02_cantilever.py``, 297 nodes: +6.5 %, Q1 −2.2 %),
+which a change of default would have to weigh.
 
 The Table 7.1 names mean what the thesis means (``mesh``);
-the package token ``kNN`` at the end of a name selects this recipe
-(``"VCBCPBG V5m Unl TL kNN"``, :mod:`skfem_pg.naming`).
+the package tokens ``kNN`` and ``meshU`` at the end of a name select
+these recipes (``"VCBCPBG V5m Unl TL kNN"``, :mod:`skfem_pg.naming`).
 """
 import numpy as np
 import skfem as fem
@@ -60,45 +80,67 @@ import skfem as fem
 #: recipe name -> (family rule, quadrature weights, bond weight exponent)
 RECIPES = {
     "mesh": ("mesh", "volume", 1),
+    "meshU": ("mesh", "uniform", 0),
     "kNN": ("nearest", "uniform", 0),
 }
-#: family rule -> the (weights, exponent) it comes with; other rules and
-#: given families: the thesis' ("volume", 1)
-_WITH_RULE = {rule: (w, n) for rule, w, n in RECIPES.values()}
+#: family rule -> the (weights, exponent) it comes with when named
+#: alone (``families="mesh"``: the thesis'); other rules and given
+#: families: the thesis' ("volume", 1)
+_WITH_RULE = {"mesh": ("volume", 1), "nearest": ("uniform", 0)}
 
 
 def default_recipe(particles, method="PBG", shape="MTE1"):
-    """The recipe :class:`~skfem_pg.FamilyBasis` uses when neither
-    ``families`` nor ``weights`` is given (module docstring): ``"kNN"``
-    for PBG with MTE1 on the vertices of a 3-D simplex mesh, else
-    ``"mesh"``."""
+    """The recipe :class:`~skfem_pg.FamilyBasis` uses when ``families``
+    is not given (module docstring): for PBG with MTE1 on the vertices of
+    a simplex mesh ``"kNN"`` in 3-D and ``"meshU"`` in 2-D, else
+    ``"mesh"``.
+
+    >>> import skfem as fem, skfem_pg as pg
+    >>> default_recipe(pg.Particles.from_mesh(fem.MeshTri()))
+    'meshU'
+    >>> default_recipe(pg.Particles.from_mesh(fem.MeshQuad()))
+    'mesh'
+    """
     mesh = particles.mesh
-    if (method == "PBG" and shape == "MTE1" and particles.dim == 3
-            and isinstance(mesh, fem.MeshTet)
-            and particles.kind == "vertices"):
-        return "kNN"
+    if method == "PBG" and shape == "MTE1" and particles.kind == "vertices":
+        if particles.dim == 3 and isinstance(mesh, fem.MeshTet):
+            return "kNN"
+        if particles.dim == 2 and isinstance(mesh, fem.MeshTri):
+            return "meshU"
     return "mesh"
 
 
 def resolve(particles, families, weights, weight_exponent, method, shape):
     """``(families, weights, weight_exponent, recipe)`` with every
-    ``None`` / ``"auto"`` replaced: ``families`` (``None``: the default
-    recipe's rule) a rule name or a :class:`~skfem_pg.Families`; weights
-    and exponent follow the family rule (``"nearest"``: ``"uniform"``, 0;
-    any other rule or given families: ``"volume"``, 1); ``recipe`` the
-    name of :data:`RECIPES` whose three choices the result makes, else
-    ``None``."""
+    ``None`` / ``"auto"`` replaced: ``families=None`` takes the default
+    recipe's rule, weights and exponent; a named rule its own
+    (``"nearest"``: ``"uniform"``, 0; ``"mesh"`` and any other rule or
+    given families: the thesis' ``"volume"``, 1); ``recipe`` the name of
+    :data:`RECIPES` whose three choices the result makes (the default
+    recipe's name first), else ``None``."""
     if families is None:
-        families = RECIPES[default_recipe(particles, method, shape)][0]
-    rule = families if isinstance(families, str) else None
-    w, n = _WITH_RULE.get(rule, RECIPES["mesh"][1:])
+        default = default_recipe(particles, method, shape)
+        families, w, n = RECIPES[default]
+    else:
+        default = None
+        w, n = weights_of_rule(families)
     if weights in (None, "auto"):
         weights = w
     if weight_exponent in (None, "auto"):
         weight_exponent = n
-    key = (rule, weights, weight_exponent)
-    recipe = next((k for k, v in RECIPES.items() if v == key), None)
+    key = (families if isinstance(families, str) else None, weights,
+           weight_exponent)
+    names = ([default] if default else []) + list(RECIPES)
+    recipe = next((k for k in names if RECIPES[k] == key), None)
     return families, weights, weight_exponent, recipe
+
+
+def weights_of_rule(rule):
+    """``(weights, exponent)`` a family rule named alone comes with
+    (``"nearest"``: uniform, 0; ``"mesh"``, other rules and given
+    families: the thesis' volume weights (4.30), 1)."""
+    return _WITH_RULE.get(rule if isinstance(rule, str) else None,
+                          RECIPES["mesh"][1:])
 
 
 def check_exponent(n):
@@ -117,5 +159,5 @@ def check_exponent(n):
     return v
 
 
-__all__ = ["RECIPES", "default_recipe", "resolve",
+__all__ = ["RECIPES", "default_recipe", "resolve", "weights_of_rule",
            "check_exponent"]

@@ -50,6 +50,7 @@ import skfem as fem
 
 from ..discretization import families as families_mod
 from ..discretization import petrov
+from ..discretization import recipes
 from ..discretization.basis import FamilyBasis
 from ..discretization.families import Families
 from ..discretization.particles import Particles
@@ -298,21 +299,12 @@ class Partition:
             raise NotImplementedError(
                 "vc={!r} on MPI: the distributed VC solve takes V3, V5 or "
                 "None".format(options["vc"]))
-        if isinstance(families, str):  # a rule (thesis names: "mesh")
-            if families != "mesh":
-                raise NotImplementedError(
-                    "families={!r} on MPI: a rank builds its families from "
-                    "the mesh (rule 'mesh') or takes them given".format(
-                        families))
-            families = None
-        if options.get("weights", "volume") not in ("auto", "volume"):
-            raise NotImplementedError(
-                "weights={!r} on MPI: the distributed basis integrates with "
-                "the volume weights (4.30)".format(options["weights"]))
+        rule = self._family_rule(families, method, options)
         fam = error = None
         try:  # an error here is raised on every rank (no rank left waiting)
-            fam = (self.families(pairwise=method == "PPG1")
-                   if families is None else families)
+            fam = (families if rule is None
+                   else self.families(pairwise=method == "PPG1")
+                   if rule == "mesh" else self.nearest_families())
             local = self._local_particles(fam, local)
         except Exception as err:  # noqa: BLE001 - raised on every rank
             error = err
@@ -335,6 +327,43 @@ class Partition:
         basis = FamilyBasis(lp, lfam, distributed=self, **options)
         self.ncomp = 1 if basis.ncomp is None else int(basis.ncomp)
         return basis
+
+    def _family_rule(self, families, method, options):
+        """The family rule of :meth:`basis` (``None`` for given families),
+        the serial keyword defaults filled into ``options``: without
+        ``families`` the recipe serial :class:`~skfem_pg.FamilyBasis`
+        takes on these particles
+        (:func:`~skfem_pg.discretization.recipes.default_recipe`), its
+        quadrature weights and bond weight exponent too, so that a run
+        on ranks repeats the serial one; a named rule its own weights."""
+        if families is not None and not isinstance(families, str):
+            return None
+        if families is None:
+            families, w, n = recipes.RECIPES[recipes.default_recipe(
+                self.particles, method, options.get("shape", "MTE1"))]
+        else:
+            w, n = recipes.weights_of_rule(families)
+        if families not in ("mesh", "nearest"):
+            raise NotImplementedError(
+                "families={!r} on MPI: a rank builds its families from "
+                "the mesh (rule 'mesh'), its nearest particles (rule "
+                "'nearest') or takes them given".format(families))
+        if method != "PBG":  # PPG integrates with the member volumes
+            return families
+        for key, value in (("weights", w), ("weight_exponent", n)):
+            if options.get(key, "auto") in (None, "auto"):
+                options[key] = value
+        return families
+
+    def nearest_families(self):
+        """The families of the owned masters by the ``"nearest"`` rule
+        (:data:`~skfem_pg.discretization.families.NEAREST` neighbours,
+        pairwise, with ties), in global particle numbers: built on the
+        replicated particle positions, so the same as serial."""
+        fam = families_mod.build("nearest", self.particles)
+        mine = np.zeros(self.n, dtype=bool)
+        mine[self.owned] = True
+        return _subset(fam, mine & self.particles.active)
 
     def _local_particles(self, fam, local=None):
         """The local particles of a basis of the families ``fam``: owned,

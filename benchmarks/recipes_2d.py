@@ -1,0 +1,328 @@
+"""PBG recipes on 2-D node sets (issue 45, item 1): the family rule, the
+quadrature weights and the bond weight exponent, against T1 / Q1 on the
+same nodes, in bending, tension and on a scalar (Poisson) problem.
+
+Geometries (gmsh triangles and recombined quadrilaterals of the same
+size; plane strain, lambda = 100, mu = 40):
+
+* ``ring`` — a curved cantilever, the quarter ring 5 <= r <= 6 clamped at
+  y = 0, a unit traction in x on its end x = 0 (bending); with mapped
+  quadrilaterals (2, 4, 8, 16 cells through the thickness) as a third
+  node set;
+* ``beam`` — a straight cantilever 10 x 1 clamped at x = 0, a unit
+  traction in y at x = 10 (bending);
+* ``lshape`` — an L bracket (the square 4 x 4 less [1, 4] x [1, 4], arms
+  of width 1) clamped at y = 0, a unit traction in x on its top end y = 4
+  (bending with a re-entrant corner);
+* ``hole`` — a quarter plate 4 x 4 with an elliptic hole (semi-axes 1 in
+  x, 0.5 in y), symmetry on x = 0 and y = 0, pulled in y on y = 4
+  (tension, stress concentration);
+* ``poisson`` — -div grad u = 1, u = 0 on the boundary of the unit
+  square, the L bracket and the unit disk.
+
+Each value is the signed compliance error f.u / f.u_ref - 1 in % (+ =
+soft, - = stiff); the reference is T2 on a finer mesh of the same
+geometry (its own error, estimated by the T2 one size coarser, is
+printed).  The ratio |e_PG| / |e_FE| at the finest node set is given
+only where neither error changes sign under refinement.  One table per geometry into
+``benchmarks/README.md`` (sections ``recipes_2d_*``).
+
+    python benchmarks/recipes_2d.py [--geometries ring beam lshape hole poisson]
+"""
+import os
+import tempfile
+import time
+import warnings
+
+import numpy as np
+import skfem as fem
+from skfem.models.poisson import laplace, unit_load
+
+import skfem_pg as pg
+from skfem_pg.formulations import linear_elasticity
+from harness import demo_parser, markdown_table, update_results
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RESULTS = os.path.join(HERE, "README.md")
+FORM = linear_elasticity(100.0, 40.0)
+
+
+def occ_mesh(build, size, quad=False, order=1):
+    """A gmsh mesh of the OpenCASCADE geometry ``build(occ)``: triangles,
+    or recombined quadrilaterals (``quad``), of size ``size``."""
+    import gmsh
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        build(gmsh.model.occ)
+        gmsh.model.occ.synchronize()
+        gmsh.model.addPhysicalGroup(
+            2, [e[1] for e in gmsh.model.getEntities(2)], 1)
+        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * size)
+        if quad:
+            gmsh.option.setNumber("Mesh.RecombineAll", 1)
+            gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
+        gmsh.model.mesh.generate(2)
+        gmsh.model.mesh.setOrder(order)
+        with tempfile.TemporaryDirectory() as tmp:
+            fn = os.path.join(tmp, "mesh.msh")
+            gmsh.write(fn)
+            mesh = fem.Mesh.load(fn)
+    finally:
+        gmsh.finalize()
+    return pg.meshing.renumber(mesh) if order == 1 else mesh
+
+
+def ring(occ):
+    outer, inner = occ.addDisk(0, 0, 0, 6, 6), occ.addDisk(0, 0, 0, 5, 5)
+    cut, _ = occ.cut([(2, outer)], [(2, inner)])
+    occ.intersect(cut, [(2, occ.addRectangle(0, 0, 0, 10, 10))])
+
+
+def mapped_ring(n):
+    """The ring as mapped quadrilaterals, n cells through the thickness,
+    8n around (near squares)."""
+    m = fem.MeshQuad.init_tensor(np.linspace(5, 6, n + 1),
+                                 np.linspace(0, np.pi / 2, 8 * n + 1))
+    return fem.MeshQuad(np.array([m.p[0] * np.cos(m.p[1]),
+                                  m.p[0] * np.sin(m.p[1])]), m.t)
+
+
+def beam(occ):
+    occ.addRectangle(0, 0, 0, 10, 1)
+
+
+def lshape(occ):
+    occ.cut([(2, occ.addRectangle(0, 0, 0, 4, 4))],
+            [(2, occ.addRectangle(1, 1, 0, 3, 3))])
+
+
+def hole(occ):
+    loop = occ.addCurveLoop([occ.addEllipse(0, 0, 0, 1.0, 0.5)])
+    occ.cut([(2, occ.addRectangle(0, 0, 0, 4, 4))],
+            [(2, occ.addPlaneSurface([loop]))])
+
+
+def square(occ):
+    occ.addRectangle(0, 0, 0, 1, 1)
+
+
+def disk(occ):
+    occ.addDisk(0, 0, 0, 1, 1)
+
+
+def on(axis, value):
+    return lambda x: np.abs(x[axis] - value) < 1e-9
+
+
+#: elasticity: geometry -> (builder, node-set sizes, overkill size,
+#: [(clamped facets, components)], (loaded facets, traction))
+ELASTIC = {
+    "ring": (ring, (0.25, 0.12, 0.06), 0.02, [(on(1, 0), (0, 1))],
+             (on(0, 0), (1.0, 0.0))),
+    "beam": (beam, (0.25, 0.125, 0.0625), 0.02, [(on(0, 0), (0, 1))],
+             (on(0, 10), (0.0, 1.0))),
+    "lshape": (lshape, (0.25, 0.12, 0.06), 0.015, [(on(1, 0), (0, 1))],
+               (on(1, 4), (1.0, 0.0))),
+    "hole": (hole, (0.3, 0.15, 0.075), 0.02,
+             [(on(0, 0), (0,)), (on(1, 0), (1,))], (on(1, 4), (0.0, 1.0))),
+}
+#: Poisson: domain -> (builder, node-set sizes, overkill size)
+POISSON = {"square": (square, (0.1, 0.05, 0.025), 0.008),
+           "lshape": (lshape, (0.25, 0.12, 0.06), 0.02),
+           "disk": (disk, (0.2, 0.1, 0.05), 0.016)}
+
+
+def _nearest(k):
+    return lambda p: pg.families.nearest(p, k)
+
+
+#: PBG variants: name -> FamilyBasis keywords (a callable ``families``
+#: gets the particles)
+VARIANTS = {
+    "mesh, volume, n = 1 (thesis; default on quads)": dict(
+        families="mesh"),
+    "mesh, uniform, n = 0 (meshU; default on triangles)": dict(
+        families="mesh", weights="uniform", weight_exponent=0),
+    "mesh, uniform, n = 1": dict(families="mesh", weights="uniform",
+                                 weight_exponent=1),
+    "6 nearest + ties, uniform, n = 0": dict(
+        families=_nearest(6), weights="uniform", weight_exponent=0),
+    "6 nearest + ties, uniform, n = 1": dict(
+        families=_nearest(6), weights="uniform", weight_exponent=1),
+    "8 nearest + ties, uniform, n = 1": dict(
+        families=_nearest(8), weights="uniform", weight_exponent=1),
+    "12 nearest + ties, uniform, n = 1": dict(
+        families=_nearest(12), weights="uniform", weight_exponent=1),
+}
+
+
+def fe_element(mesh):
+    return pg.particles.linear_elements(mesh)[0]
+
+
+def _dirichlet(basis, mesh, clamps):
+    D = []
+    for select, comps in clamps:
+        dofs = basis.get_dofs(mesh.facets_satisfying(select))
+        for c in comps:
+            key = "u^{}".format(c + 1)
+            D += [d[key] for d in (dofs.nodal, dofs.facet) if key in d]
+    return np.unique(np.concatenate(D))
+
+
+def elastic_compliance(basis, mesh, spec):
+    """f.u of the elastic problem ``spec`` on ``basis``."""
+    _, _, _, clamps, (loaded, t) = spec
+    K = pg.assemble(FORM, basis)
+    facets = mesh.facets_satisfying(loaded)
+    if isinstance(basis, pg.FamilyBasis):
+        f = pg.traction(basis, facets, list(t))
+    else:
+        fb = fem.FacetBasis(mesh, basis.elem, facets=facets)
+        f = fem.LinearForm(lambda v, w: t[0] * v[0] + t[1] * v[1]) \
+            .assemble(fb)
+    D = _dirichlet(basis, mesh, clamps)
+    u = fem.solve(*fem.condense(K, f, D=D), solver=pg.solvers.direct)
+    return float(f @ u)
+
+
+def poisson_compliance(basis, mesh):
+    K, f = pg.assemble(laplace, basis), pg.assemble(unit_load, basis)
+    D = basis.get_dofs()
+    D = D.all() if hasattr(D, "all") else D
+    u = fem.solve(*fem.condense(K, f, D=D), solver=pg.solvers.direct)
+    return float(f @ u)
+
+
+def pg_basis(mesh, kw, dim):
+    kw = dict(kw)
+    p = pg.Particles.from_mesh(mesh)
+    if callable(kw.get("families")):
+        kw["families"] = kw["families"](p)
+    return pg.FamilyBasis(p, dim=dim, **kw)
+
+
+def ratio_at_finest(errs, fe_errs):
+    """|e_PG| / |e_FE| at the finest node set as text, or ``"crosses
+    zero"`` where either error changes sign under refinement (its small
+    value there is a crossing, not convergence)."""
+    if errs is fe_errs:
+        return ""
+    for e in (errs, fe_errs):
+        if not np.all(np.isfinite(e)) or len(set(np.sign(e))) > 1:
+            return "crosses zero"
+    return "{:.2f}".format(abs(errs[-1] / fe_errs[-1]))
+
+
+def table(title, kinds, compliance, reference):
+    """Rows of signed errors for each variant on each node-set kind;
+    printed and returned as markdown."""
+    lines = []
+    for kind, meshes in kinds.items():
+        fe_name = "T1" if isinstance(meshes[0], fem.MeshTri) else "Q1"
+        nodes = [int(m.nvertices) for m in meshes]
+        rows, fe_err = [], None
+        for name in [fe_name] + list(VARIANTS):
+            errs, secs = [], 0.0
+            for m in meshes:
+                t0 = time.perf_counter()
+                try:
+                    c = compliance(m, None if name == fe_name
+                                   else VARIANTS[name])
+                    errs.append(100 * (c / reference - 1))
+                except (pg.FamilyError, pg.CorrectionError) as err:
+                    print("   ", name, nodes, type(err).__name__, err)
+                    errs.append(np.nan)
+                secs += time.perf_counter() - t0
+            if name == fe_name:
+                fe_err = errs
+            ratio = ratio_at_finest(errs, fe_err)
+            rows.append([name] + ["{:+.2f} %".format(e) for e in errs]
+                        + [ratio, "{:.2f}".format(secs)])
+            print("  {:50s}".format(name) + " ".join(
+                "{:+8.2f}".format(e) for e in errs), ratio, flush=True)
+        lines.append("**{}, {}** ({} nodes; FE = {})\n\n".format(
+            title, kind, " / ".join(map(str, nodes)), fe_name)
+            + markdown_table(["method"] + ["{} nodes".format(n)
+                                           for n in nodes]
+                             + ["PG/FE at the finest", "time [s]"], rows))
+    return "\n\n".join(lines)
+
+
+def overkill_and_node_sets(title, build, sizes, ref_size, solve):
+    """``(n0, c0, n1, ref, kinds)``: ``solve(mesh)`` (f.u) on T2 meshes of
+    sizes 1.5 ``ref_size`` and ``ref_size``, and the gmsh triangle and
+    quadrilateral node sets of ``sizes``."""
+    refs = []
+    for s in (1.5 * ref_size, ref_size):
+        m = occ_mesh(build, s, order=2)
+        refs.append((m.nvertices, solve(m)))
+    (n0, c0), (n1, ref) = refs
+    print("\n{}: T2 overkill {} / {} nodes, compliance {:.7g} / {:.7g} "
+          "({:+.1e})".format(title, n0, n1, c0, ref, ref / c0 - 1),
+          flush=True)
+    kinds = {"gmsh triangles": [occ_mesh(build, s) for s in sizes],
+             "gmsh quadrilaterals": [occ_mesh(build, s, quad=True)
+                                     for s in sizes]}
+    return n0, c0, n1, ref, kinds
+
+
+def elastic_study(name):
+    spec = ELASTIC[name]
+    n0, c0, n1, ref, kinds = overkill_and_node_sets(
+        name, *spec[:3], lambda m: elastic_compliance(fem.Basis(
+            m, fem.ElementVector(fem.ElementTriP2())), m, spec))
+    if name == "ring":
+        kinds["mapped quadrilaterals"] = [mapped_ring(n) for n in
+                                          (2, 4, 8, 16)]
+
+    def compliance(mesh, kw):
+        basis = (fem.Basis(mesh, fem.ElementVector(fe_element(mesh)))
+                 if kw is None else pg_basis(mesh, kw, 2))
+        return elastic_compliance(basis, mesh, spec)
+
+    text = ("`python benchmarks/recipes_2d.py --geometries {}`: signed "
+            "compliance error (+ = soft) against T2 on {} nodes (its "
+            "difference to {} nodes: {:+.1e}).\n\n".format(
+                name, n1, n0, ref / c0 - 1)
+            + table(name, kinds, compliance, ref))
+    print("updated", update_results(RESULTS, "recipes_2d_" + name, text))
+
+
+def poisson_study():
+    parts = []
+    for name, (build, sizes, ref_size) in POISSON.items():
+        n0, c0, n1, ref, kinds = overkill_and_node_sets(
+            "poisson " + name, build, sizes, ref_size,
+            lambda m: poisson_compliance(fem.Basis(m, fem.ElementTriP2()),
+                                         m))
+
+        def compliance(mesh, kw):
+            basis = (fem.Basis(mesh, fe_element(mesh)) if kw is None
+                     else pg_basis(mesh, kw, None))
+            return poisson_compliance(basis, mesh)
+
+        parts.append("Against T2 on {} nodes ({:+.1e} to {} nodes); on "
+                     "the disk the node sets' polygons lose area, which "
+                     "FE and PG share.\n\n".format(n1, ref / c0 - 1, n0)
+                     + table("Poisson, " + name, kinds, compliance, ref))
+    text = ("`python benchmarks/recipes_2d.py --geometries poisson`: "
+            "-div grad u = 1, u = 0 on the boundary; signed error of "
+            "f.u (+ = soft).\n\n" + "\n\n".join(parts))
+    print("updated", update_results(RESULTS, "recipes_2d_poisson", text))
+
+
+def main(geometries):
+    warnings.filterwarnings("ignore", message="Indefinite matrix")
+    for g in geometries:
+        poisson_study() if g == "poisson" else elastic_study(g)
+
+
+if __name__ == "__main__":
+    ap = demo_parser(__doc__, quick=False)
+    choices = list(ELASTIC) + ["poisson"]
+    ap.add_argument("--geometries", nargs="+", default=choices,
+                    choices=choices, help="which problems to study")
+    main(ap.parse_args().geometries)
