@@ -20,12 +20,18 @@ size; plane strain, lambda = 100, mu = 40):
 * ``poisson`` — -div grad u = 1, u = 0 on the boundary of the unit
   square, the L bracket and the unit disk.
 
+Variants: the thesis recipe (the default on quadrilaterals), ``meshU``
+(the default on triangles), nearest-neighbour families with ties, and
+the moment-matched quadrature of the quadratic fit
+(``family_quadrature="moments"``,
+:mod:`skfem_pg.discretization.moment_quadrature`).
+
 Each value is the signed compliance error f.u / f.u_ref - 1 in % (+ =
 soft, - = stiff); the reference is T2 on a finer mesh of the same
 geometry (its own error, estimated by the T2 one size coarser, is
 printed).  The ratio |e_PG| / |e_FE| at the finest node set is given
-only where neither error changes sign under refinement.  One table per geometry into
-``benchmarks/README.md`` (sections ``recipes_2d_*``).
+only where neither error changes sign under refinement.  One table per
+geometry into ``benchmarks/README.md`` (sections ``recipes_2d_*``).
 
     python benchmarks/recipes_2d.py [--geometries ring beam lshape hole poisson]
 """
@@ -155,6 +161,8 @@ VARIANTS = {
         families=_nearest(8), weights="uniform", weight_exponent=1),
     "12 nearest + ties, uniform, n = 1": dict(
         families=_nearest(12), weights="uniform", weight_exponent=1),
+    "WTE2, moment quadrature (MQ)": dict(shape="WTE2",
+                                         family_quadrature="moments"),
 }
 
 

@@ -1,7 +1,8 @@
 r"""Thesis names of formulations (Table 7.1) <-> ``FamilyBasis`` options.
 
 A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
-{formulation} [TL|UL] [noBC] [kNN|meshU]``, e.g. ``"VCBCPBG V5sn Unl TL"``, or
+{formulation} [TL|UL] [noBC] [kNN|meshU] [MQ]``, e.g.
+``"VCBCPBG V5sn Unl TL"``, or
 ``FEM {T1|Q1|O1|H1|Q1P0|H1P0|T2|Q2|O2|H2}`` for the FE comparators:
 
 ==========  ==============================================================
@@ -35,6 +36,9 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
             families with uniform quadrature weights and unit bond
             weights) — the keyword API's default for PBG Unl on 2-D
             triangles
+``MQ``      a package token: the moment-matched family quadrature
+            (:mod:`skfem_pg.discretization.moment_quadrature`) of U2
+            instead of the members
 ==========  ==============================================================
 
 So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
@@ -63,7 +67,8 @@ from .discretization import recipes
 _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
                    r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
-                   r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN|meshU))?$")
+                   r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN|meshU))?"
+                   r"(?:\s+(?P<quad>MQ))?$")
 _BOUNDARY = {"p": "p", "s": "s", "sn": "sn", "m": "min-norm"}
 
 
@@ -155,6 +160,9 @@ def parse(name):
         if shape != "WTE2":
             kw["families"] = "mesh"
         kw.update(weights="volume", weight_exponent=1)
+    if g["quad"]:  # the rule makes its own weights; WTE2's exponent
+        kw.pop("weights")
+        kw["family_quadrature"] = "moments"
     notes = []
     if g["vc"] is None:
         if g["variant"] or g["boundary"]:
@@ -215,4 +223,6 @@ def name_of(basis):
     tail = " noBC" if first_order and not basis.bond else ""
     if getattr(basis, "recipe", None) in ("kNN", "meshU"):
         tail += " " + basis.recipe
+    if getattr(basis, "family_quadrature", "members") == "moments":
+        tail += " MQ"
     return "{}{}{} {} TL{}".format(prefix, method, variant, form, tail)

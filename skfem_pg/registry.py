@@ -75,7 +75,8 @@ def register(token, shape, build, kind="displacement", master_only=False,
     unknown shape or kind, a ``build`` that is not callable, a token
     already registered unless ``replace``).  Returns the record."""
     if not isinstance(token, str) or not re.fullmatch(r"[^\s]+", token) \
-            or token in ("TL", "UL", "noBC", "kNN", "meshU", "FEM"):
+            or token in ("TL", "UL", "noBC", "kNN", "meshU", "MQ",
+                             "FEM"):
         raise ValueError("a formulation token is one word and not a name "
                          "keyword, got {!r}".format(token))
     if shape not in SHAPE_FUNCTIONS:

@@ -25,7 +25,9 @@ def test_spec_resolves_defaults_once(particles):
 
 @pytest.mark.parametrize("kw", [{}, {"method": "PPG1"},
                                 {"shape": "WTE1"},
-                                {"vc_boundary": "s"}])
+                                {"vc_boundary": "s"},
+                                {"shape": "WTE2",
+                                 "family_quadrature": "moments"}])
 def test_from_spec_is_the_keyword_constructor(particles, kw):
     a = pg.FamilyBasis(particles, dim=2, **kw)
     b = pg.FamilyBasis.from_spec(particles,

@@ -1,7 +1,8 @@
 """The kNN recipe (nearest-neighbour families, uniform quadrature weights,
 unit bond weights; the keyword default of PBG Unl on 3-D tetrahedra) and
 the meshU recipe (mesh families, uniform weights, unit bond weights; the
-default on 2-D triangles) keep every guarantee of the thesis' recipe: the linear patch test, exactly the
+default on 2-D triangles) keep every guarantee of the thesis' recipe: the
+linear patch test, exactly the
 rigid-body zero modes, and convergence rates of at least 2 (L2) and 1
 (H1); near-singular families are repaired or refused."""
 import numpy as np

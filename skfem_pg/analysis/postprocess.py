@@ -2,7 +2,8 @@ r"""Particle fields for output: deformation gradient, Cauchy stress and
 von Mises stress at every particle.
 
 The particle value is the master evaluation of its own family,
-:math:`F^{kk}`.  Stresses come from the material evaluated in 3-D; in 2-D,
+:math:`F^{kk}` (:meth:`~skfem_pg.FamilyBasis.master_gradients`).
+Stresses come from the material evaluated in 3-D; in 2-D,
 ``F`` is embedded with :math:`F_{33} = 1` (plane strain), so
 :math:`\sigma_{33}` enters the von Mises stress
 :math:`\sqrt{\tfrac32\, s:s}`, :math:`s = \sigma - \tfrac13\mathrm{tr}\sigma`.
@@ -40,7 +41,10 @@ def particle_fields(basis, material, u):
     them."""
     p = basis.particles
     n, d = p.n, p.dim
-    F = basis.interpolate(u).grad[:, :, :, 0] + np.eye(d)[:, :, None]
+    U = np.asarray(u, dtype=float).reshape(n, d)
+    mem, _ = basis.families.padded()
+    F = np.einsum("kia,kib->abk", U[mem], basis.master_gradients()) \
+        + np.eye(d)[:, :, None]
     sigma, vm = cauchy_and_von_mises(material, F)
     masters = basis.families.masters
     out = {"displacement": u.reshape(n, d),

@@ -57,16 +57,18 @@ def l2_error(basis, u, exact):
 
 def h1_error(basis, u, exact_grad):
     """Discrete H1 seminorm error; ``exact_grad(x)`` returns
-    ``(ncomp, dim, ...)`` at member positions ``x`` (``(dim, nf, m)``).
-    The quadrature is the PBG one, :math:`w_{kj} = V^kV^j/V_H^k`, for PPG
-    bases too (their weights :math:`V^j` count each particle once per
-    family it belongs to)."""
+    ``(ncomp, dim, ...)`` at the quadrature points ``x`` (``(dim, nf,
+    m)``: the members, or the points of ``family_quadrature="moments"``).
+    The quadrature is the basis' own for PBG, and the PBG one,
+    :math:`w_{kj} = V^kV^j/V_H^k`, for PPG bases (their weights
+    :math:`V^j` count each particle once per family it belongs to)."""
     g = basis.interpolate(u).grad
     x = basis.global_coordinates()
     ge = np.broadcast_to(exact_grad(np.asarray(x)), g.shape)
     err = ((g - ge) ** 2).reshape(-1, *g.shape[-2:]).sum(axis=0)
-    return float(np.sqrt(np.sum(
-        pbg_weights(basis.particles.volumes, basis.families) * err)))
+    w = (pbg_weights(basis.particles.volumes, basis.families)
+         if basis.is_petrov else basis.dx)
+    return float(np.sqrt(np.sum(w * err)))
 
 
 def nodal_interpolant(basis, field):

@@ -8,8 +8,10 @@ systems.
                            vectors, fold and inversion checks)
 ``families``               family builders (mesh connectivity, horizons,
                            nearest neighbours) and their rule names
+``moment_quadrature``      the moment-matched family quadrature of the
+                           quadratic fit (``family_quadrature``)
 ``recipes``                which families, quadrature and bond weights a
-                           basis uses by default (thesis' or kNN)
+                           basis uses by default (thesis', meshU or kNN)
 ``quadrature``             PBG quadrature weights (volume (4.30), uniform)
 ``shape``                  WTE1/MTE1, WTE2, least-squares and LME derivatives
 ``corrections``            bond (5.55) and VC (5.57)–(5.64) corrections;

@@ -78,24 +78,28 @@ class _FamilyView:
         self.nc = 1 if self.scalar else basis.ncomp
         self.n_nodes = basis.particles.n
         self.shape = (L.n_families, L.m_max)
+        values = basis.grouped_values() or [None] * len(L)
         self.blocks = [
-            _Block(g.members, dx, self._ext_grad(G),
+            _Block(g.members, dx, self._ext_grad(G, N),
                    (lambda C, g=g: L.take(C, g, axis=0)), g.families, G, g,
                    grad_t=lambda sl, b=b: basis.grouped_gradients_t()[b][sl])
-            for b, (g, G, dx) in enumerate(zip(L, basis.grouped_gradients(),
-                                               basis.grouped_weights()))]
+            for b, (g, G, dx, N) in enumerate(zip(
+                L, basis.grouped_gradients(), basis.grouped_weights(),
+                values))]
 
     @staticmethod
-    def _ext_grad(G):
+    def _ext_grad(G, N=None):
         m = G.shape[1]
 
         def ext_grad(sl, channels):
-            """``Ĝ[k, j, i, β]`` for families ``sl``; β over
-            ``channels``."""
+            r"""``Ĝ[k, j, i, β]`` for families ``sl``; β over
+            ``channels`` (β = 0: the values, :math:`\delta_{ij}` where
+            the members are the quadrature points, else ``N``)."""
             Gs = G[sl]
             if list(channels) == list(range(1, Gs.shape[-1] + 1)):
                 return Gs  # the gradients alone: no copy
-            parts = [np.broadcast_to(np.eye(m), Gs.shape[:3]) if beta == 0
+            parts = [(np.broadcast_to(np.eye(m), Gs.shape[:3]) if N is None
+                      else N[sl]) if beta == 0
                      else Gs[..., beta - 1] for beta in channels]
             return np.stack(parts, axis=-1)
         return ext_grad

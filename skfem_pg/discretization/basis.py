@@ -75,7 +75,8 @@ class FamilyBasis(AbstractBasis):
         :class:`~skfem_pg.discretization.families.Families`, or a rule of
         :data:`~skfem_pg.discretization.families.RULES`: ``"mesh"`` (mesh
         connectivity), ``"nearest"`` (the 10 (3-D) / 6 (2-D) nearest
-        particles and those as near as the last, pairwise) or ``"horizon"`` (1.51 h).  Default: the
+        particles and those as near as the last, pairwise) or
+        ``"horizon"`` (1.51 h).  Default: the
         recipe of :mod:`~skfem_pg.discretization.recipes` — ``"nearest"``
         for PBG MTE1 on 3-D tetrahedra (recipe ``kNN``), else ``"mesh"``
         (on 2-D triangles with uniform weights and unit bond weights,
@@ -159,6 +160,16 @@ class FamilyBasis(AbstractBasis):
         ``basis.area_correction``, which the loads of
         :mod:`skfem_pg.discretization.loads` include.
 
+    family_quadrature
+        ``"members"`` (default: the members are the quadrature points,
+        the thesis' (4.25)) or ``"moments"``
+        (:mod:`~skfem_pg.discretization.moment_quadrature`: the quadratic
+        fit WTE2 evaluated at :math:`2d` points per family that integrate
+        quadratic polynomials like the master's hat function; with
+        ``shape="WTE2"``, PBG, V3 or no VC; default families the mesh's
+        1-ring, enlarged to :math:`2 + d + d(d+1)/2` members).  In
+        bending 0.02–0.4 times T1's / Q1's error on the same nodes
+        (``benchmarks/README.md``, "2-D recipes").
     vc_tolerance
         Largest accepted constraint residual after the VC correction,
         relative to :math:`h^{d-1}` (default 1e-8: the patch test holds
@@ -222,7 +233,8 @@ class FamilyBasis(AbstractBasis):
                  test_shape: str = "master", lme_mu: float = 1.8,
                  vc_boundary: str = "min-norm",
                  vc_tolerance: float | None = 1e-8, distributed=None,
-                 weights: str = "auto") -> None:
+                 weights: str = "auto",
+                 family_quadrature: str = "members") -> None:
         particles = _as_particles(particles)
         spec = BasisSpec.resolve(
             particles, families=families, shape=shape, bond=bond, vc=vc,
@@ -230,7 +242,8 @@ class FamilyBasis(AbstractBasis):
             vc_solver=vc_solver, vc_exclude=vc_exclude,
             test_shape=test_shape, lme_mu=lme_mu, vc_boundary=vc_boundary,
             vc_tolerance=vc_tolerance, weights=weights,
-            area_vectors=area_vectors)
+            area_vectors=area_vectors,
+            family_quadrature=family_quadrature)
         self._hold(particles, spec, builder.build(
             particles, spec, area_vectors=area_vectors,
             distributed=distributed), distributed)
@@ -259,6 +272,12 @@ class FamilyBasis(AbstractBasis):
         self.options = spec.options()
         self.distributed = distributed
         self.families, self.dx = arrays.families, arrays.dx
+        self.family_quadrature = spec.family_quadrature
+        #: ``family_quadrature="moments"``: the values ``(nf, m, m)`` and
+        #: positions ``(nf, m, d)`` of the quadrature slots; ``None``: the
+        #: members (values :math:`\delta_{ij}`)
+        self.values, self.points = arrays.values, arrays.points
+        self._master_gradients = arrays.master_gradients
         self.timings, self.vc_report = arrays.timings, arrays.vc_report
         self._G, self._G_groups = arrays.G, arrays.G_groups
         self.test = None
@@ -357,8 +376,11 @@ class FamilyBasis(AbstractBasis):
         a, c = divmod(ix, nc)
         mem, mask = self.families.padded()
         nf, m = mem.shape
-        value = np.zeros((nf, m))
-        value[:, a] = mask[:, a]
+        if self.values is None:
+            value = np.zeros((nf, m))
+            value[:, a] = mask[:, a]
+        else:
+            value = self.values[:, :, a].copy()
         grad = np.moveaxis(self.G[:, :, a, :], -1, 0)
         if self.ncomp is None:
             return (DiscreteField(value, grad),)
@@ -413,6 +435,27 @@ class FamilyBasis(AbstractBasis):
                 for G in self.grouped_gradients()]
         return self._Gt_groups
 
+    def grouped_values(self):
+        r"""Shape-function values at the quadrature slots per size group,
+        ``(nf_b, m, m)`` ``[k, j, i]``, or ``None`` where the members are
+        the quadrature points (values :math:`\delta_{ij}`)."""
+        if self.values is None:
+            return None
+        if getattr(self, "_values_groups", None) is None:
+            self._values_groups = [
+                np.ascontiguousarray(self.values[g.families, :g.m, :g.m])
+                for g in self.layout]
+        return self._values_groups
+
+    def master_gradients(self):
+        r"""``(nf, m, d)`` derivatives :math:`G^{kki}` at each family's
+        master (what particle output evaluates): the first quadrature
+        slot's where the members are the quadrature points, the quadratic
+        fit's at the master with ``family_quadrature="moments"``."""
+        if self._master_gradients is not None:
+            return self._master_gradients
+        return self.G[:, 0]
+
     def grouped_weights(self):
         """``dx`` without padding: per size group ``(nf_b, m)``."""
         return [self.layout.take(self.dx, g) for g in self.layout]
@@ -449,9 +492,10 @@ class FamilyBasis(AbstractBasis):
         W = w.reshape(-1, nc)
         value = np.empty((nc, L.n_points))
         grad = np.empty((nc, d, L.n_points))
-        for g, G in zip(L, self.grouped_gradients()):
+        Ns = self.grouped_values() or [None] * len(L.groups)
+        for g, G, N in zip(L, self.grouped_gradients(), Ns):
             U = W[g.members]  # (nf_b, m, nc)
-            value[:, g.flat] = np.moveaxis(U, -1, 0)
+            value[:, g.flat] = np.moveaxis(U if N is None else N @ U, -1, 0)
             gr = np.swapaxes(G, -1, -2) @ U[:, None]  # (nf_b, m, d, nc)
             grad[:, :, g.flat] = gr.transpose(3, 2, 0, 1)
         if flat:
@@ -493,7 +537,9 @@ class FamilyBasis(AbstractBasis):
         :math:`\sum_k\sum_j w_{kj} N^{ki}(X^j) N^{kl}(X^j) = \delta_{il}
         m_i` with :math:`m_i = \sum_{k \ni i} w_{ki}`, and the L2 projection
         :math:`\sum_k w_{ki} f(X^i) / m_i = f(X^i)` *is* the nodal
-        interpolation.  Quadrature-point
+        interpolation; with ``family_quadrature="moments"`` too (the
+        values at the points are the master's,
+        :mod:`~skfem_pg.discretization.moment_quadrature`).  Quadrature-point
         fields (``DiscreteField``) are not accepted: average them with
         :func:`skfem_pg.analysis.postprocess.particle_fields` instead."""
         if kwargs:
@@ -556,6 +602,8 @@ class FamilyBasis(AbstractBasis):
         return self.mesh.draw(**kwargs)
 
     def global_coordinates(self):
+        if self.points is not None:
+            return DiscreteField(np.moveaxis(self.points, -1, 0))
         mem, _ = self.families.padded()
         return DiscreteField(np.moveaxis(self.particles.x.T[mem], -1, 0))
 

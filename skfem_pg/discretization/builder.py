@@ -53,6 +53,7 @@ from .shape.least_squares import (mls1_master_gradients,
                                    wls2_master_gradients)
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
+from .moment_quadrature import moment_quadrature
 from . import local_vc
 from ..naming import parse
 
@@ -123,6 +124,9 @@ class BasisSpec:
     #: the name of :data:`skfem_pg.discretization.recipes.RECIPES` whose
     #: families, weights and exponent these are, else ``None``
     recipe: Optional[str] = None
+    #: ``"members"`` (the thesis': the members are the quadrature points)
+    #: or ``"moments"`` (:mod:`~skfem_pg.discretization.moment_quadrature`)
+    family_quadrature: str = "members"
 
     @property
     def ppg(self):
@@ -134,6 +138,7 @@ class BasisSpec:
         (PBG with MTE1/WTE1, vc V3/V5 or none, no excluded particles,
         boundary ``min-norm`` / ``p``)."""
         return (not self.ppg and self.shape in ("MTE1", "WTE1")
+                and self.family_quadrature == "members"
                 and self.vc in (None, "V3", "V5") and self.vc_exclude is None
                 and self.vc_boundary in ("min-norm", "p"))
 
@@ -143,6 +148,8 @@ class BasisSpec:
         out = {f.name: getattr(self, f.name)
                for f in dataclasses.fields(self)
                if f.name not in ("families", "recipe")}
+        if self.family_quadrature == "moments":
+            del out["weights"]  # the rule makes its own
         if isinstance(self.families, str):
             out["families"] = self.families
         return out
@@ -163,7 +170,8 @@ class BasisSpec:
                 vc="auto", method="PBG", dim=None, weight_exponent="auto",
                 vc_solver="auto", vc_exclude=None, test_shape="master",
                 lme_mu=1.8, vc_boundary="min-norm", vc_tolerance=1e-8,
-                weights="auto", area_vectors=None):
+                weights="auto", area_vectors=None,
+                family_quadrature="members"):
         """The spec of :class:`~skfem_pg.FamilyBasis`'s keywords, defaults
         filled in; raises ``ValueError`` / ``NotImplementedError`` naming
         the option for a combination the stages cannot build
@@ -233,6 +241,17 @@ class BasisSpec:
         if ppg and weights not in ("auto", None, "volume"):
             raise ValueError("weights={!r} is a PBG option: PPG integrates "
                              "with the member volumes V^j".format(weights))
+        if family_quadrature not in ("members", "moments"):
+            raise ValueError("family_quadrature must be 'members' or "
+                             "'moments', got {!r}".format(family_quadrature))
+        if family_quadrature == "moments":
+            _check_moments(particles, shape, method, vc, vc_boundary,
+                           vc_exclude, weights)
+            if families is None:  # the 1-ring, a quadratic fit's members
+                d = particles.dim
+                families = families_mod.from_mesh(
+                    particles, min_size=2 + d + d * (d + 1) // 2, order=2)
+            weights = "uniform"  # not used: the rule makes its own
         if families is None and shape == "WTE2":
             # twice the d + d(d+1)/2 quadratic moments, plus the master:
             # with fewer, corner families of graded meshes (Cook's (48,
@@ -252,7 +271,33 @@ class BasisSpec:
                    vc_solver=vc_solver, vc_exclude=vc_exclude,
                    test_shape=test_shape, lme_mu=lme_mu,
                    vc_boundary=vc_boundary, vc_tolerance=vc_tolerance,
-                   recipe=recipe)
+                   recipe=None if family_quadrature == "moments"
+                   else recipe, family_quadrature=family_quadrature)
+
+
+def _check_moments(particles, shape, method, vc, vc_boundary, vc_exclude,
+                   weights):
+    """Refuse what the moment quadrature does not build, naming the
+    option."""
+    if shape != "WTE2" or method != "PBG":
+        raise ValueError(
+            "family_quadrature='moments' integrates the quadratic fit WTE2 "
+            "of PBG: pass shape='WTE2' (method='PBG'), got shape={!r}, "
+            "method={!r}".format(shape, method))
+    if vc not in (None, "V3") or vc_boundary != "min-norm" \
+            or vc_exclude is not None:
+        raise NotImplementedError(
+            "family_quadrature='moments' is built with the first-order VC "
+            "V3 (or none), vc_boundary='min-norm' and no vc_exclude; got "
+            "vc={!r}, vc_boundary={!r}".format(vc, vc_boundary))
+    if weights not in ("auto", None):
+        raise ValueError("weights={!r}: family_quadrature='moments' makes "
+                         "its own weights (the hat functions' moments)"
+                         .format(weights))
+    if particles.mesh is None or particles.kind != "vertices":
+        raise ValueError(
+            "family_quadrature='moments' needs particles collocated from a "
+            "mesh's vertices (their hat functions' moments)")
 
 
 @dataclasses.dataclass
@@ -269,6 +314,13 @@ class BasisArrays:
     test_master: Optional[np.ndarray] = None
     vc_report: object = None
     timings: dict = dataclasses.field(default_factory=dict)
+    #: ``family_quadrature="moments"``: shape-function values ``(nf, m, m)``,
+    #: positions ``(nf, m, d)`` of the quadrature slots, the derivatives at
+    #: the masters ``(nf, m, d)``; ``None`` when the members are the
+    #: quadrature points (values :math:`\delta_{ij}`)
+    values: Optional[np.ndarray] = None
+    points: Optional[np.ndarray] = None
+    master_gradients: Optional[np.ndarray] = None
 
 
 @dataclasses.dataclass
@@ -446,7 +498,15 @@ def _what(spec):
 
 def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
     x, V = particles.x, particles.volumes
-    G = trial_gradients(particles, fam, spec, timings)
+    extra = {}
+    if spec.family_quadrature == "moments":
+        t0 = time.perf_counter()
+        G, dx, *more = moment_quadrature(particles, fam,
+                                         n=spec.weight_exponent)
+        extra = dict(zip(("values", "points", "master_gradients"), more))
+        timings["gradients"] = time.perf_counter() - t0
+    else:
+        G = trial_gradients(particles, fam, spec, timings)
     Gt = dx_t = None
     if spec.ppg:
         dx = petrov.quadrature_weights(V, fam)
@@ -454,9 +514,10 @@ def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
         Gt[:, 0] = TEST_GRADIENTS[spec.test_shape](particles, fam, G, spec)
         dx_t = np.zeros(fam.padded()[0].shape)  # the masters' weights only
         dx_t[:, 0] = V[fam.masters]
-    else:
+    elif not extra:
         dx = weight_rule(spec.weights)(V, fam)
     report = None
+    first = G[:, 0].copy() if extra else None
     if spec.vc is not None:
         t0 = time.perf_counter()
         c = _Context(particles, spec, fam, G, dx, Gt, dx_t,
@@ -468,8 +529,14 @@ def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
                      spec.vc_tolerance, what=_what(spec))
     if spec.ppg:  # the trial derivatives too
         check_correction(G, x, fam, None, what=spec.shape + " trial")
+    if extra and spec.vc is not None:
+        # the correction moves the masters' derivatives with the points'
+        # (V3: the same α^k φ^{ki} at every point of family k)
+        extra["master_gradients"] = extra["master_gradients"] + (
+            G[:, 0] - first)
     return BasisArrays(fam, dx, G=G, vc_report=report, timings=timings,
-                       test_master=None if Gt is None else Gt[:, 0])
+                       test_master=None if Gt is None else Gt[:, 0],
+                       **extra)
 
 
 def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):

@@ -146,9 +146,10 @@ class Families:
                              shape=(self.n_particles, self.n_particles))
 
 
-def _needs_enlargement(x, fam, min_size):
+def _needs_enlargement(x, fam, min_size, order=1):
     """Families with too few members or with non-master members that do not
-    span the space affinely."""
+    span the space affinely (``order=2``: whose offsets from the master do
+    not determine a quadratic fit, e.g. two layers of a grid)."""
     mem, mask = fam.padded()
     small = fam.sizes < min_size
     # centred non-master member positions, scaled per family
@@ -163,10 +164,18 @@ def _needs_enlargement(x, fam, min_size):
     S = np.swapaxes(D, -1, -2) @ D
     ev = np.linalg.eigvalsh(S)
     flat = ev[:, 0] <= 1e-8 * np.maximum(ev[:, -1], 1e-300)
+    if order == 2:
+        from .shape.quadratic import taylor2_basis
+        D0 = (P - P[:, :1]) * mask[..., None]
+        D0 = D0 / np.maximum(np.abs(D0).max(axis=(1, 2)), 1e-300)[:, None,
+                                                                   None]
+        p = taylor2_basis(D0) * others[..., None]
+        eq = np.linalg.eigvalsh(np.swapaxes(p, -1, -2) @ p)
+        flat |= eq[:, 0] <= 1e-8 * np.maximum(eq[:, -1], 1e-300)
     return small | flat
 
 
-def _complete(x, A, masters, min_size, max_rings=3):
+def _complete(x, A, masters, min_size, max_rings=3, order=1):
     """Build families from ``A`` and enlarge the deficient ones ring by
     ring; families the rings cannot fix (isolated clusters, or neighbours
     all on one line of a strongly anisotropic node set) get their nearest
@@ -176,7 +185,7 @@ def _complete(x, A, masters, min_size, max_rings=3):
     A = A.tocsr().astype(bool)
     k = min(min_size + x.shape[0], len(masters))
     for ring in range(max_rings + 64):
-        need = _needs_enlargement(x, fam, min_size)
+        need = _needs_enlargement(x, fam, min_size, order)
         if not np.any(need):
             break
         rows = masters[need]
@@ -205,7 +214,7 @@ def _mesh_of(obj):
     return obj, "vertices", None, obj.p
 
 
-def from_mesh(mesh_or_particles, elements=None, min_size=None):
+def from_mesh(mesh_or_particles, elements=None, min_size=None, order=1):
     """Families from mesh connectivity (the default builder).
 
     Parameters
@@ -220,6 +229,10 @@ def from_mesh(mesh_or_particles, elements=None, min_size=None):
         Minimum family size, master included (default ``dim + 2``).
         Smaller families, and families whose non-master members are
         collinear/coplanar, get the next ring of neighbours.
+    order
+        2: also families whose members do not determine a quadratic
+        Taylor fit (WTE2) get the next ring (the edge and corner nodes of
+        a hexahedral grid: two layers in a direction).
 
     """
     mesh, kind, pel, x = _mesh_of(mesh_or_particles)
@@ -238,7 +251,7 @@ def from_mesh(mesh_or_particles, elements=None, min_size=None):
                             np.tile(np.arange(ne), mesh.t.shape[0]))),
                           shape=(nv, ne))
         A = (E.T @ E).astype(bool)
-        return _complete(x, A, np.arange(ne), min_size)
+        return _complete(x, A, np.arange(ne), min_size, order=order)
     tind = (np.arange(mesh.nelements) if elements is None
             else np.asarray(mesh.normalize_elements(elements)))
     t = mesh.t[:, tind]
@@ -248,7 +261,7 @@ def from_mesh(mesh_or_particles, elements=None, min_size=None):
                       shape=(nv, len(tind)))
     A = (E @ E.T).astype(bool)
     masters = np.unique(t)
-    return _complete(x, A, masters, min_size)
+    return _complete(x, A, masters, min_size, order=order)
 
 
 def _active_tree(particles):

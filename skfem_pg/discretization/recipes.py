@@ -59,16 +59,21 @@ every refinement.  On Poisson problems it is stiff: −0.16 / −0.35 /
 The nearest-neighbour families, with or without equidistant ties, are
 no better there and change sign under refinement.
 
-On quadrilaterals and hexahedral grids no recipe of the study is
-robustly better than the thesis' (its tables: on gmsh quadrilaterals
-the best variant per geometry is 0.14–1.6 times Q1's error, and the
-winner changes with the geometry; on mapped quadrilaterals of the
-curved cantilever all are worse than Q1), so ``mesh`` stays their
+On quadrilaterals and hexahedral grids no recipe of MTE1 is robustly
+better than the thesis' (the study's tables: on gmsh quadrilaterals the
+best variant per geometry is 0.14–1.6 times Q1's error, and the winner
+changes with the geometry; on mapped quadrilaterals of the curved
+cantilever all are worse than Q1 or change sign), so ``mesh`` stays their
 default; in bending on coarse node sets it is soft (a 5 × 1 × 1
 hexahedral beam, 525 nodes: tip +38 %, H1 −3.4 %,
 ``tests/test_gallery.py``; the plane-strain cantilever of
-``docs/examples/ex02_cantilever.py``, 297 nodes: +6.5 %, Q1 −2.2 %),
-which a change of default would have to weigh.
+``docs/examples/ex02_cantilever.py``, 297 nodes: +6.5 %, Q1 −2.2 %).
+What is robustly better there is not a recipe but another quadrature:
+the quadratic fit WTE2 at moment-matched points
+(``shape="WTE2", family_quadrature="moments"``,
+:mod:`~skfem_pg.discretization.moment_quadrature`; 0.09–0.41 times Q1's
+error, 0.05 times H1's on the hex beam), opt-in until it runs on MPI
+ranks and under the thesis' formulations.
 
 The Table 7.1 names mean what the thesis means (``mesh``);
 the package tokens ``kNN`` and ``meshU`` at the end of a name select

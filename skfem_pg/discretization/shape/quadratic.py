@@ -57,12 +57,26 @@ def taylor2_derivatives(D):
 
 def wte2_gradients(x, volumes, fam, n=1):
     """WTE2 derivatives, shape ``(nf, m, m, d)`` (U2)."""
+    return wte2_at(x, volumes, fam, n=n)[0]
+
+
+def wte2_at(x, volumes, fam, points=None, n=1):
+    r"""The WTE2 fit of each family evaluated at ``points``: derivatives
+    ``G[k, j, i]`` and values ``N[k, j, i]`` of the shape function of
+    member ``i`` at point ``j`` of family ``k``, shapes ``(nf, P, m, d)``
+    and ``(nf, P, m)``; ``points`` ``(nf, P, d)`` absolute positions
+    (default: the members, ``P = m``).  The values are
+    :math:`N^{kji} = c^{ki}\cdot p(y^j - X^k)` for :math:`i \ne k` and
+    :math:`1 - \sum_{i\ne k} N^{kji}` for the master (the expansion
+    interpolates it); both are exact for quadratic fields."""
     mem_all, mask_all = fam.padded()
     nf, m = mem_all.shape
     d = x.shape[0]
     q = d + d * (d + 1) // 2
-    G = np.zeros((nf, m, m, d))
-    for sl in chunks(nf, m * m * q):
+    P = m if points is None else points.shape[1]
+    G = np.zeros((nf, P, m, d))
+    N = np.zeros((nf, P, m))
+    for sl in chunks(nf, max(m, P) * m * q):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
         # the master has r2 = 0
@@ -73,10 +87,18 @@ def wte2_gradients(x, volumes, fam, n=1):
         Minv, singular = inverse_spd(M)
         check_singular(x, fam, sl, geo, singular, "WTE2", False)
         c = Wp @ Minv  # (k, i, q): coefficients, M symmetric
-        dp = taylor2_derivatives(D) * geo.mask[..., None, None]  # (k, j, q, d)
+        if points is None:
+            Y, at = D, geo.mask
+        else:
+            Y = (points[sl] - x.T[mem_all[sl, :1]]) / geo.h[:, None, None]
+            at = np.ones(Y.shape[:2], dtype=bool)
+        dp = taylor2_derivatives(Y) * at[..., None, None]  # (k, j, q, d)
         # G[k, j, i, :] = c[k, i, :] @ dp[k, j]
         g = np.einsum("kiq,kjqd->kjid", c, dp)
         g[:, :, 0] = -g[:, :, 1:].sum(axis=2)
         g /= geo.h[:, None, None, None]
-        G[sl] = g * geo.mask[:, :, None, None]
-    return G
+        v = np.einsum("kiq,kjq->kji", c, taylor2_basis(Y)) * at[..., None]
+        v[:, :, 0] = at - v[:, :, 1:].sum(axis=2)
+        G[sl] = g * geo.mask[:, None, :, None]
+        N[sl] = v * geo.mask[:, None, :]
+    return G, N
