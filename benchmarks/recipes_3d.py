@@ -1,7 +1,8 @@
 """PBG recipes on 3-D node sets: the thesis' (mesh families, volume
 weights) against kNN (nearest-neighbour families, uniform weights, unit
-bond weights; the default on tetrahedra since issue #27), O1 and O2 on
-the same nodes, linear elasticity (lambda = 100, mu = 40).
+bond weights; the default on tetrahedra since issue #27) and the
+moment-matched quadrature of the quadratic fit (MQ, issue 45), O1 and O2
+on the same nodes, linear elasticity (lambda = 100, mu = 40).
 
 Geometries (``--geometries``):
 
@@ -54,6 +55,8 @@ METHODS = {
     "H1": lambda m: fem.Basis(m, fem.ElementVector(fem.ElementHex1())),
     "PG thesis (mesh)": lambda m: pg.FamilyBasis(m, dim=3, families="mesh"),
     "PG kNN": lambda m: pg.FamilyBasis(m, dim=3, families="nearest"),
+    "PG MQ": lambda m: pg.FamilyBasis(m, dim=3, shape="WTE2",
+                                      family_quadrature="moments"),
 }
 
 
@@ -119,15 +122,15 @@ def main(geometries):
                     for n in (24, 32)]
             METHODS["H2"] = lambda m: fem.Basis(
                 m, fem.ElementVector(fem.ElementHex2()))
-            study(g, spec, meshes, ["H1", "PG thesis (mesh)", "PG kNN"],
-                  refs, "H2")
+            study(g, spec, meshes, ["H1", "PG thesis (mesh)", "PG kNN",
+                                    "PG MQ"], refs, "H2")
             continue
         spec = GEOMETRIES[g]
         geo = pg.meshing.geo_path(spec[0])
         meshes = [pg.meshing.from_geo(geo, size=s) for s in spec[6]]
         refs = [pg.meshing.from_geo(geo, size=s) for s in spec[7]]
-        study(g, spec, meshes, ["O1", "O2", "PG thesis (mesh)", "PG kNN"],
-              refs, "O2")
+        study(g, spec, meshes, ["O1", "O2", "PG thesis (mesh)", "PG kNN",
+                                "PG MQ"], refs, "O2")
 
 
 if __name__ == "__main__":

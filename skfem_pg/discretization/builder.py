@@ -54,6 +54,7 @@ from .shape.least_squares import (mls1_master_gradients,
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
 from .moment_quadrature import moment_quadrature
+from .moment_quadrature import default_families as moment_families
 from . import local_vc
 from ..naming import parse
 
@@ -248,9 +249,7 @@ class BasisSpec:
             _check_moments(particles, shape, method, vc, vc_boundary,
                            vc_exclude, weights)
             if families is None:  # the 1-ring, a quadratic fit's members
-                d = particles.dim
-                families = families_mod.from_mesh(
-                    particles, min_size=2 + d + d * (d + 1) // 2, order=2)
+                families = moment_families(particles)
             weights = "uniform"  # not used: the rule makes its own
         if families is None and shape == "WTE2":
             # twice the d + d(d+1)/2 quadratic moments, plus the master:

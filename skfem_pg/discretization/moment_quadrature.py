@@ -47,6 +47,28 @@ from .particles import linear_elements
 from .shape.quadratic import wte2_at
 
 
+#: smallest family, master included, of the moment quadrature's default
+#: families (the mesh's 1-ring, enlarged): in 2-D the quadratic fit's
+#: 1 + 5 plus one (the triangles' 1-ring); in 3-D its 1 + 9 are too few
+#: for well-conditioned fits on gmsh tetrahedra (a 20 x 2 x 2 cantilever,
+#: 1089 nodes: −8.3 % with 12 members at least, −1.6 % with 14, −2.3 %
+#: with 17; O1 −17 %), and 13–16 gave the same on Cook's membrane
+#: (``benchmarks/README.md``, "2-D recipes"); in 2-D 8 or 10 were no
+#: better than 7
+MIN_MEMBERS = {1: 4, 2: 7, 3: 14}
+
+
+def default_families(particles):
+    """The moment quadrature's default families: the collocation mesh's
+    1-ring, enlarged to :data:`MIN_MEMBERS` members and until the
+    members' offsets determine a quadratic fit
+    (:func:`~skfem_pg.discretization.families.from_mesh` with
+    ``order=2``)."""
+    from .families import from_mesh
+    return from_mesh(particles, min_size=MIN_MEMBERS[particles.dim],
+                     order=2)
+
+
 def hat_moments(particles):
     r"""``(V, Xc, M2)`` of every particle's hat function on its collocation
     mesh: :math:`\int N_k`, the centroid :math:`\int N_k x / \int N_k`
@@ -129,4 +151,5 @@ def moment_quadrature(particles, families, n=1):
     return G, dx, values, points, Gp[:, P]
 
 
-__all__ = ["hat_moments", "moment_points", "moment_quadrature"]
+__all__ = ["MIN_MEMBERS", "default_families", "hat_moments",
+           "moment_points", "moment_quadrature"]
