@@ -31,7 +31,8 @@ soft, - = stiff); the reference is T2 on a finer mesh of the same
 geometry (its own error, estimated by the T2 one size coarser, is
 printed).  The ratio |e_PG| / |e_FE| at the finest node set is given
 only where neither error changes sign under refinement.  One table per
-geometry into ``benchmarks/README.md`` (sections ``recipes_2d_*``).
+geometry into ``benchmarks/README.md`` and ``docs/guide/accuracy.md``
+(sections ``recipes_2d_*``).
 
     python benchmarks/recipes_2d.py [--geometries ring beam lshape hole poisson]
 """
@@ -49,7 +50,10 @@ from skfem_pg.formulations import linear_elasticity
 from harness import demo_parser, markdown_table, update_results
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-RESULTS = os.path.join(HERE, "README.md")
+#: the pages whose sections ``recipes_2d_*`` this script writes: the
+#: measurements page and the documentation's accuracy page
+RESULTS = [os.path.join(HERE, "README.md"),
+           os.path.join(HERE, os.pardir, "docs", "guide", "accuracy.md")]
 FORM = linear_elasticity(100.0, 40.0)
 
 
@@ -296,7 +300,12 @@ def elastic_study(name):
             "difference to {} nodes: {:+.1e}).\n\n".format(
                 name, n1, n0, ref / c0 - 1)
             + table(name, kinds, compliance, ref))
-    print("updated", update_results(RESULTS, "recipes_2d_" + name, text))
+    write(name, text)
+
+
+def write(name, text):
+    for page in RESULTS:
+        print("updated", update_results(page, "recipes_2d_" + name, text))
 
 
 def poisson_study():
@@ -319,7 +328,7 @@ def poisson_study():
     text = ("`python benchmarks/recipes_2d.py --geometries poisson`: "
             "-div grad u = 1, u = 0 on the boundary; signed error of "
             "f.u (+ = soft).\n\n" + "\n\n".join(parts))
-    print("updated", update_results(RESULTS, "recipes_2d_poisson", text))
+    write("poisson", text)
 
 
 def main(geometries):
