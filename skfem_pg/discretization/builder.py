@@ -249,6 +249,11 @@ class BasisSpec:
             _check_moments(particles, shape, method, vc, vc_boundary,
                            vc_exclude, weights)
             if families is None:  # the 1-ring, a quadratic fit's members
+                if particles.mesh is None:
+                    raise ValueError(
+                        "family_quadrature='moments' needs particles "
+                        "collocated from a mesh's vertices (their hat "
+                        "functions' moments and 1-ring families)")
                 families = moment_families(particles)
             weights = "uniform"  # not used: the rule makes its own
         if families is None and shape == "WTE2":
@@ -293,10 +298,6 @@ def _check_moments(particles, shape, method, vc, vc_boundary, vc_exclude,
         raise ValueError("weights={!r}: family_quadrature='moments' makes "
                          "its own weights (the hat functions' moments)"
                          .format(weights))
-    if particles.mesh is None or particles.kind != "vertices":
-        raise ValueError(
-            "family_quadrature='moments' needs particles collocated from a "
-            "mesh's vertices (their hat functions' moments)")
 
 
 @dataclasses.dataclass
@@ -349,7 +350,7 @@ class _Context:
 
 def _first_order_pbg(c):
     s, p = c.spec, c.particles
-    c.G, c.report = vc_correction(
+    c.G, c.report = c.vc_solve(
         c.G, c.dx, p.x, p.volumes, c.families, c.area, c.phi(s.vc),
         variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
         boundary=s.vc_boundary, surface=c.surface)
@@ -495,13 +496,15 @@ def _what(spec):
         else ", boundary " + spec.vc_boundary)
 
 
-def _padded(particles, fam, spec, area_vectors, vc_solve, timings):
+def _padded(particles, fam, spec, area_vectors, vc_solve, timings,
+            moments=None):
     x, V = particles.x, particles.volumes
     extra = {}
     if spec.family_quadrature == "moments":
         t0 = time.perf_counter()
         G, dx, *more = moment_quadrature(particles, fam,
-                                         n=spec.weight_exponent)
+                                         n=spec.weight_exponent,
+                                         moments=moments)
         extra = dict(zip(("values", "points", "master_gradients"), more))
         timings["gradients"] = time.perf_counter() - t0
     else:
@@ -571,10 +574,11 @@ def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
 
 
 def distributed_supports(spec):
-    """Whether a partition can build ``spec``: the grouped PBG pipeline, or
-    PPG1 with vc V3 or none, boundary ``min-norm`` and master test
-    derivatives (its VC solve and test derivatives span the ranks)."""
-    return spec.grouped or (
+    """Whether a partition can build ``spec``: the grouped PBG pipeline,
+    the moment quadrature (its VC is first-order PBG), or PPG1 with vc V3
+    or none, boundary ``min-norm`` and master test derivatives (its VC
+    solve and test derivatives span the ranks)."""
+    return spec.grouped or spec.family_quadrature == "moments" or (
         spec.method == "PPG1" and spec.vc in (None, "V3")
         and spec.vc_boundary == "min-norm" and spec.test_shape == "master")
 
@@ -586,7 +590,8 @@ def build(particles, spec, area_vectors=None, distributed=None):
     if distributed is not None and not distributed_supports(spec):
         raise NotImplementedError(
             "a distributed basis is PBG with MTE1/WTE1 and vc V3/V5 "
-            "or None, or PPG1 with vc V3 or None")
+            "or None, WTE2 with family_quadrature='moments', or PPG1 with "
+            "vc V3 or None")
     timings = {}
     t0 = time.perf_counter()
     fam = make_families(particles, spec, distributed)
@@ -596,8 +601,14 @@ def build(particles, spec, area_vectors=None, distributed=None):
     else:
         vc_solve = (vc_correction if distributed is None
                     else distributed.vc_correction)
-    stages = _grouped if spec.grouped else _padded
-    return stages(particles, fam, spec, area_vectors, vc_solve, timings)
+    if spec.grouped:
+        return _grouped(particles, fam, spec, area_vectors, vc_solve,
+                        timings)
+    moments = None  # a rank's particles have no mesh: the partition's
+    if distributed is not None and spec.family_quadrature == "moments":
+        moments = distributed.hat_moments(local=True)
+    return _padded(particles, fam, spec, area_vectors, vc_solve, timings,
+                   moments)
 
 
 __all__ = ["BasisArrays", "BasisSpec", "CORRECTIONS", "METHODS", "surface_of",

@@ -102,10 +102,12 @@ def hat_moments(particles):
     return S0, Xc, M2
 
 
-def moment_points(particles, families):
+def moment_points(particles, families, moments=None):
     """The :math:`2d` quadrature points of each family (module docstring):
-    ``(points, weights)``, shapes ``(nf, 2d, d)`` and ``(nf, 2d)``."""
-    V, Xc, M2 = hat_moments(particles)
+    ``(points, weights)``, shapes ``(nf, 2d, d)`` and ``(nf, 2d)``;
+    ``moments``: :func:`hat_moments` given (a rank's particles, which have
+    no mesh)."""
+    V, Xc, M2 = hat_moments(particles) if moments is None else moments
     k = families.masters
     d = particles.dim
     lam, vec = np.linalg.eigh(M2[k])
@@ -117,7 +119,7 @@ def moment_points(particles, families):
     return pts, np.repeat(V[k][:, None] / (2 * d), 2 * d, axis=1)
 
 
-def moment_quadrature(particles, families, n=1):
+def moment_quadrature(particles, families, n=1, moments=None):
     r"""``(G, dx, values, points, G_master)`` of a family basis with the
     moment-matched quadrature: padded ``(nf, m, m, d)`` derivatives at the
     quadrature slots (the :math:`2d` points first, zero elsewhere),
@@ -128,7 +130,7 @@ def moment_quadrature(particles, families, n=1):
     mem, mask = families.padded()
     nf, m = mem.shape
     d = particles.dim
-    pts, w = moment_points(particles, families)
+    pts, w = moment_points(particles, families, moments)
     P = pts.shape[1]
     if m < P:
         raise ParticleError(

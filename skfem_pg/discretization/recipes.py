@@ -72,8 +72,8 @@ What is robustly better there is not a recipe but another quadrature:
 the quadratic fit WTE2 at moment-matched points
 (``shape="WTE2", family_quadrature="moments"``,
 :mod:`~skfem_pg.discretization.moment_quadrature`; 0.09–0.41 times Q1's
-error, 0.05 times H1's on the hex beam), opt-in until it runs on MPI
-ranks and under the thesis' formulations.
+error, 0.05 times H1's on the hex beam), opt-in until the thesis'
+formulations are measured on it.
 
 The Table 7.1 names mean what the thesis means (``mesh``);
 the package tokens ``kNN`` and ``meshU`` at the end of a name select

@@ -51,6 +51,7 @@ import skfem as fem
 from ..discretization import families as families_mod
 from ..discretization import petrov
 from ..discretization import recipes
+from ..discretization.moment_quadrature import MIN_MEMBERS, hat_moments
 from ..discretization.basis import FamilyBasis
 from ..discretization.families import Families
 from ..discretization.particles import Particles
@@ -232,18 +233,19 @@ class Partition:
         return cells if pel is None else np.intersect1d(cells, pel)
 
     # -- families and the local basis ---------------------------------------
-    def families(self, min_size=None, pairwise=False):
+    def families(self, min_size=None, pairwise=False, order=1):
         """The families of the owned masters, in global particle numbers
         (mesh connectivity, as
         :func:`~skfem_pg.discretization.families.from_mesh`); with
         ``pairwise`` completed as
         :func:`~skfem_pg.discretization.petrov.pairwise` (from the
         families of twice as many rings: every family that may hold an
-        owned particle)."""
+        owned particle); ``order=2``: enlarged until they determine a
+        quadratic fit (the moment quadrature's)."""
         ring = families_mod.from_mesh(
             self.mesh, elements=self.ring_cells(2 * RINGS if pairwise
                                                 else RINGS),
-            min_size=min_size)
+            min_size=min_size, order=order)
         if pairwise:
             ring = petrov.pairwise(ring)
         mine = np.zeros(self.n, dtype=bool)
@@ -267,6 +269,7 @@ class Partition:
         sub = copy.copy(self)
         sub.particles = Particles.from_mesh(self.mesh, elements=cells)
         sub._area = None
+        sub._hat = None
         return sub
 
     def basis(self, families=None, local=None, **options):
@@ -285,10 +288,13 @@ class Partition:
             raise NotImplementedError(
                 "method={!r} on MPI: this version distributes PBG and PPG1"
                 .format(method))
-        if options.get("shape", "MTE1") not in ("MTE1", "WTE1"):
+        moments = options.get("family_quadrature") == "moments"
+        if options.get("shape", "MTE1") not in ("MTE1", "WTE1") \
+                and not moments:
             raise NotImplementedError(
                 "shape={!r} on MPI: this version distributes the linear "
-                "bases MTE1 and WTE1".format(options["shape"]))
+                "bases MTE1 and WTE1, and WTE2 with family_quadrature="
+                "'moments'".format(options["shape"]))
         for key, allowed in (("vc_boundary", ("min-norm", "p")),
                              ("vc_exclude", (None,))):
             if options.get(key, allowed[0]) not in allowed:
@@ -299,12 +305,17 @@ class Partition:
             raise NotImplementedError(
                 "vc={!r} on MPI: the distributed VC solve takes V3, V5 or "
                 "None".format(options["vc"]))
-        rule = self._family_rule(families, method, options)
+        rule = ("moments" if moments and families is None
+                else self._family_rule(families, method, options))
         fam = error = None
         try:  # an error here is raised on every rank (no rank left waiting)
-            fam = (families if rule is None
-                   else self.families(pairwise=method == "PPG1")
-                   if rule == "mesh" else self.nearest_families())
+            if rule == "moments":  # the serial default_families, per rank
+                fam = self.families(
+                    min_size=MIN_MEMBERS[self.particles.dim], order=2)
+            else:
+                fam = (families if rule is None
+                       else self.families(pairwise=method == "PPG1")
+                       if rule == "mesh" else self.nearest_families())
             local = self._local_particles(fam, local)
         except Exception as err:  # noqa: BLE001 - raised on every rank
             error = err
@@ -354,6 +365,17 @@ class Partition:
             if options.get(key, "auto") in (None, "auto"):
                 options[key] = value
         return families
+
+    def hat_moments(self, local=False):
+        """:func:`~skfem_pg.discretization.moment_quadrature.hat_moments`
+        of the whole body (computed once, on every rank: the mesh is
+        replicated); ``local``: restricted to :attr:`local`, what a rank's
+        basis with ``family_quadrature="moments"`` integrates."""
+        if getattr(self, "_hat", None) is None:
+            self._hat = hat_moments(self.particles)
+        if not local:
+            return self._hat
+        return tuple(a[self.local] for a in self._hat)
 
     def nearest_families(self):
         """The families of the owned masters by the ``"nearest"`` rule
