@@ -104,6 +104,22 @@ def test_linear_elasticity_equals_serial(kw):
     assert info["iterations"] < 100  # CG + GAMG with rigid-body modes
 
 
+def _simplex_cantilever(kind):
+    """A distorted triangle square or tetrahedron cube, clamped on one
+    side, loaded on the opposite one: ``(mesh, f, D)``."""
+    if kind == "tri":
+        mesh, elem = square(8, 0.3, seed=3, kind="tri"), fem.ElementTriP1()
+    else:
+        mesh, elem = cube(4, 0.2, seed=4, kind="tet"), fem.ElementTetP1()
+    e = fem.ElementVector(elem)
+    fb = fem.FacetBasis(mesh, e, facets=mesh.facets_satisfying(
+        lambda x: np.isclose(x[0], 1)))
+    f = fem.LinearForm(lambda v, w: 1.0 * v[1] + 0.5 * v[0]).assemble(fb)
+    D = fem.Basis(mesh, e).get_dofs(
+        lambda x: np.isclose(x[0], -1 if kind == "tri" else 0)).all()
+    return mesh, f, D
+
+
 @pytest.mark.parametrize("kind, recipe", [("tri", "meshU"),
                                           ("tet", "kNN")])
 def test_default_recipe_on_ranks_equals_serial(kind, recipe):
@@ -111,17 +127,8 @@ def test_default_recipe_on_ranks_equals_serial(kind, recipe):
     take ``meshU`` (uniform weights, unit bond weights), 3-D tetrahedra
     ``kNN`` (nearest families with ties, from the replicated positions),
     as serial :class:`~skfem_pg.FamilyBasis` does."""
-    if kind == "tri":
-        mesh, elem = square(8, 0.3, seed=3, kind="tri"), fem.ElementTriP1()
-    else:
-        mesh, elem = cube(4, 0.2, seed=4, kind="tet"), fem.ElementTetP1()
+    mesh, f, D = _simplex_cantilever(kind)
     d = mesh.dim()
-    e = fem.ElementVector(elem)
-    fb = fem.FacetBasis(mesh, e, facets=mesh.facets_satisfying(
-        lambda x: np.isclose(x[0], 1)))
-    f = fem.LinearForm(lambda v, w: 1.0 * v[1] + 0.5 * v[0]).assemble(fb)
-    D = fem.Basis(mesh, e).get_dofs(
-        lambda x: np.isclose(x[0], -1 if kind == "tri" else 0)).all()
     sb = pg.FamilyBasis(mesh, dim=d)
     assert sb.recipe == recipe
     u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
@@ -138,17 +145,8 @@ def test_moment_quadrature_on_ranks_equals_serial(kind):
     families (1-ring enlarged to a quadratic fit), hat-function moments
     from the replicated mesh and the VC correction over the ranks give
     the serial solution."""
-    if kind == "tri":
-        mesh, elem = square(8, 0.3, seed=3, kind="tri"), fem.ElementTriP1()
-    else:
-        mesh, elem = cube(4, 0.2, seed=4, kind="tet"), fem.ElementTetP1()
+    mesh, f, D = _simplex_cantilever(kind)
     d = mesh.dim()
-    e = fem.ElementVector(elem)
-    fb = fem.FacetBasis(mesh, e, facets=mesh.facets_satisfying(
-        lambda x: np.isclose(x[0], 1)))
-    f = fem.LinearForm(lambda v, w: 1.0 * v[1] + 0.5 * v[0]).assemble(fb)
-    D = fem.Basis(mesh, e).get_dofs(
-        lambda x: np.isclose(x[0], -1 if kind == "tri" else 0)).all()
     kw = dict(shape="WTE2", family_quadrature="moments")
     sb = pg.FamilyBasis(mesh, dim=d, **kw)
     u_s = fem.solve(*fem.condense(pg.assemble(FORM, sb), f, D=D))
