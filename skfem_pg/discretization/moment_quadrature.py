@@ -55,7 +55,7 @@ from .shape.quadratic import wte2_at
 #: with 17; O1 −17 %), and 13–16 gave the same on Cook's membrane
 #: (``benchmarks/README.md``, "2-D recipes"); in 2-D 8 or 10 were no
 #: better than 7
-MIN_MEMBERS = {1: 4, 2: 7, 3: 14}
+MIN_MEMBERS = {2: 7, 3: 14}
 
 
 def default_families(particles):
@@ -65,6 +65,10 @@ def default_families(particles):
     (:func:`~skfem_pg.discretization.families.from_mesh` with
     ``order=2``)."""
     from .families import from_mesh
+    if particles.dim not in MIN_MEMBERS:
+        raise NotImplementedError(
+            "family_quadrature='moments' is built for 2-D and 3-D "
+            "particles, got {}-D".format(particles.dim))
     return from_mesh(particles, min_size=MIN_MEMBERS[particles.dim],
                      order=2)
 
@@ -80,8 +84,8 @@ def hat_moments(particles):
         raise ParticleError(
             "family_quadrature='moments' integrates the particles' hat "
             "functions on their collocation mesh: it needs particles "
-            "collocated from "
-            "a mesh's vertices (Particles.from_mesh), got {}".format(
+            "collocated from a mesh's vertices (Particles.from_mesh), got "
+            "{}".format(
                 "particles without a mesh" if mesh is None
                 else "{} particles".format(particles.kind)))
     e1, _ = linear_elements(mesh)
@@ -132,10 +136,12 @@ def moment_quadrature(particles, families, n=1, moments=None):
     d = particles.dim
     pts, w = moment_points(particles, families, moments)
     P = pts.shape[1]
-    if m < P:
+    small = np.nonzero(families.sizes < P)[0]
+    if len(small):  # the unpadded layout keeps n_k slots per family
         raise ParticleError(
-            "family_quadrature='moments' puts {} points into each family; the "
-            "largest family has {} members".format(P, m))
+            "family_quadrature='moments' puts {} points into each family; "
+            "the family of particle {} has {} members".format(
+                P, families.masters[small[0]], families.sizes[small[0]]))
     x, V = particles.x, particles.volumes
     at_master = x.T[families.masters][:, None, :]
     Gp, _ = wte2_at(x, V, families, np.concatenate([pts, at_master], 1),
