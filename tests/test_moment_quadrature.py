@@ -226,6 +226,10 @@ def test_refusals():
         pg.FamilyBasis(mesh, dim=2, vc="V4", **MQ)
     with pytest.raises(ValueError, match="family_quadrature must be"):
         pg.FamilyBasis(mesh, dim=2, family_quadrature="gauss")
+    from skfem_pg.formulations.updated_lagrange import UpdatedLagrange
+    with pytest.raises(NotImplementedError, match="UL with family_quad"):
+        UpdatedLagrange(pg.FamilyBasis(mesh, dim=2, **MQ),
+                        LinearElastic(LAM, MU))
     p = pg.Particles.from_mesh(mesh)
     with pytest.raises(ValueError, match="mesh's vertices"):
         pg.FamilyBasis(pg.Particles(p.x, p.volumes), dim=2, vc=None,

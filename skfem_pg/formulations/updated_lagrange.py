@@ -115,6 +115,13 @@ class UpdatedLagrange(Hyperelastic):
                              "particles must come from Particles.from_mesh")
         if int(every) < 1:
             raise ValueError("every must be >= 1, got {}".format(every))
+        if getattr(basis, "family_quadrature", "members") != "members":
+            raise NotImplementedError(
+                "UL with family_quadrature={!r}: the history is carried "
+                "over between the members of old and new families, and "
+                "the moment quadrature's points are not members (they "
+                "move with the hat functions' principal axes)".format(
+                    basis.family_quadrature))
         super().__init__(basis, material)
         self.every = int(every)
         self.current = basis
