@@ -234,3 +234,18 @@ def test_refusals():
     with pytest.raises(ValueError, match="mesh's vertices"):
         pg.FamilyBasis(pg.Particles(p.x, p.volumes), dim=2, vc=None,
                        families=pg.families.horizon(p, factor=2.51), **MQ)
+
+
+def test_cell_coefficients_at_the_points():
+    """A piecewise coefficient (one value per cell) is evaluated at the
+    moment quadrature's points, not at the members: every point left of
+    the material interface x = 0.5 gets the left value."""
+    from skfem_pg.discretization.coefficients import cell_values_at_members
+    mesh = fem.MeshTri().refined(3)
+    values = np.where(mesh.p[0, mesh.t].mean(axis=0) < 0.5, 1.0, 10.0)
+    b = pg.FamilyBasis(mesh, dim=2, **MQ)
+    c = cell_values_at_members(b, values)
+    x = np.asarray(b.global_coordinates())[0]
+    used = b.dx > 0
+    assert np.all(c[used & (x < 0.49)] == 1.0)
+    assert np.all(c[used & (x > 0.51)] == 10.0)

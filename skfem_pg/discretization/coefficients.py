@@ -10,7 +10,9 @@ evaluates the coefficient of the bond instead: member :math:`j` of family
 :math:`k` gets the value of the cell that contains the bond midpoint
 :math:`(X^k + X^j)/2`, and the master itself the volume-weighted mean of
 the cells around it.  A family on the interface thus sees both sides, each
-in proportion to its bonds.
+in proportion to its bonds.  With ``family_quadrature="moments"``
+(:mod:`~skfem_pg.discretization.moment_quadrature`) the quadrature points
+are not members: each gets the value of the cell that contains it.
 """
 import numpy as np
 import skfem as fem
@@ -52,7 +54,33 @@ def cell_values_at_members(basis, values):
     np.add.at(total, mesh.t.ravel(),
               np.broadcast_to(volume * values, mesh.t.shape).ravel())
     out[:, 0] = total[masters] / weight[masters]
+    points = getattr(basis, "points", None)
+    if points is not None:  # family_quadrature="moments": its own points
+        out = _at_points(mesh, values, points, basis.dx > 0, out[:, :1])
     return np.where(mask, out, 0.0)
+
+
+def _at_points(mesh, values, points, used, master_mean):
+    """``values`` of the cells that contain the quadrature points
+    ``points`` ``(nf, m, d)`` where ``used``, else the masters' mean (a
+    point outside the node set's polygon, beside a curved boundary)."""
+    out = np.broadcast_to(master_mean, used.shape).copy()
+    find = mesh.element_finder()
+    P = points[used]  # (n, d)
+    cells = np.full(len(P), -1)
+    try:
+        cells[:] = find(*P.T)
+    except ValueError:  # some point outside: one at a time
+        for i, q in enumerate(P):
+            try:
+                cells[i] = find(*q[:, None])[0]
+            except ValueError:
+                pass
+    inside = cells >= 0
+    vals = out[used]
+    vals[inside] = values[cells[inside]]
+    out[used] = vals
+    return out
 
 
 __all__ = ["cell_values_at_members"]
