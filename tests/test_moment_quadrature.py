@@ -249,3 +249,21 @@ def test_cell_coefficients_at_the_points():
     used = b.dx > 0
     assert np.all(c[used & (x < 0.49)] == 1.0)
     assert np.all(c[used & (x > 0.51)] == 10.0)
+
+
+def test_mixed_formulations_see_the_points():
+    """Per-family polynomials (U2P1's linear pressure) are centred on the
+    moment quadrature's points, not on the members; the nodal-pressure
+    formulations, which interpolate to the members, refuse it."""
+    from skfem_pg.discretization.elementwise import Elements
+    from skfem_pg.formulations import model_for
+    from skfem_pg.materials import NeoHookeIsoVol
+    mesh = square(6, 0.2, seed=1, kind="tri")
+    b = pg.FamilyBasis(mesh, dim=2, **MQ)
+    X = Elements(b).positions()[:, 0]
+    L = b.layout
+    for g in L:
+        assert np.allclose(X[:, g.flat], np.moveaxis(
+            b.points[g.families, :g.m], -1, 0))
+    with pytest.raises(NotImplementedError, match="members"):
+        model_for("U2P1C", b, NeoHookeIsoVol(30.0, 300.0))

@@ -75,13 +75,16 @@ class Elements:
 
     def positions(self):
         """Reference coordinates of the points, ``(d, *point_shape)``:
-        Gauss points, or family members (the particles)."""
+        Gauss points, or family members (the particles), or the points of
+        ``family_quadrature="moments"``."""
         if self.family:
             L = self.basis.layout
             x = self.basis.particles.x
+            points = getattr(self.basis, "points", None)
             flat = np.empty((x.shape[0], L.n_points))
             for g in L:
-                flat[:, g.flat] = x[:, g.members]
+                flat[:, g.flat] = x[:, g.members] if points is None else \
+                    np.moveaxis(points[g.families, :g.m], -1, 0)
             return flat[:, None, :]
         return np.asarray(self.basis.global_coordinates().value)
 

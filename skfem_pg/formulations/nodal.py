@@ -98,6 +98,12 @@ class NodalPressure(Hyperelastic):
                 "U2P1C and Unl+P1C are built on PBG family bases (got {})"
                 .format(type(basis).__name__ if not is_family_basis(basis)
                         else "a Petrov–Galerkin basis"))
+        if getattr(basis, "points", None) is not None:
+            raise NotImplementedError(
+                "U2P1C and Unl+P1C interpolate p and Theta from the "
+                "master's derivatives to the members; with "
+                "family_quadrature='moments' the quadrature points are not "
+                "members: use the members (the default)")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
         self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
         self.bubble = bool(bubble)
