@@ -159,7 +159,8 @@ def parse(name):
     else:  # the thesis' families (WTE2: its horizon) and weights
         if shape != "WTE2":
             kw["families"] = "mesh"
-        kw.update(weights="volume", weight_exponent=1)
+        _, weights, exponent = recipes.RECIPES["mesh"]
+        kw.update(weights=weights, weight_exponent=exponent)
     if g["quad"]:  # the rule makes its own weights; WTE2's exponent
         kw.pop("weights")
         kw["family_quadrature"] = "moments"

@@ -455,7 +455,13 @@ class FamilyBasis(AbstractBasis):
         fit's at the master with ``family_quadrature="moments"``."""
         if self._master_gradients is not None:
             return self._master_gradients
-        return self.G[:, 0]
+        if self._G is not None:
+            return self._G[:, 0]
+        L = self.layout  # from the size groups: no padded G built
+        Gm = np.zeros((L.n_families, L.m_max, self.particles.dim))
+        for g, G in zip(L, self.grouped_gradients()):
+            Gm[g.families, :g.m] = G[:, 0]
+        return Gm
 
     def grouped_weights(self):
         """``dx`` without padding: per size group ``(nf_b, m)``."""

@@ -58,19 +58,24 @@ from .shape.quadratic import wte2_at
 MIN_MEMBERS = {2: 7, 3: 14}
 
 
-def default_families(particles):
-    """The moment quadrature's default families: the collocation mesh's
-    1-ring, enlarged to :data:`MIN_MEMBERS` members and until the
-    members' offsets determine a quadratic fit
-    (:func:`~skfem_pg.discretization.families.from_mesh` with
-    ``order=2``)."""
-    from .families import from_mesh
-    if particles.dim not in MIN_MEMBERS:
+def family_options(dim):
+    """The keywords of
+    :func:`~skfem_pg.discretization.families.from_mesh` that make the
+    moment quadrature's default families: the 1-ring enlarged to
+    :data:`MIN_MEMBERS` members and until the members' offsets determine
+    a quadratic fit (``order=2``)."""
+    if dim not in MIN_MEMBERS:
         raise NotImplementedError(
             "family_quadrature='moments' is built for 2-D and 3-D "
-            "particles, got {}-D".format(particles.dim))
-    return from_mesh(particles, min_size=MIN_MEMBERS[particles.dim],
-                     order=2)
+            "particles, got {}-D".format(dim))
+    return dict(min_size=MIN_MEMBERS[dim], order=2)
+
+
+def default_families(particles):
+    """The moment quadrature's default families on ``particles``
+    (:func:`family_options`)."""
+    from .families import from_mesh
+    return from_mesh(particles, **family_options(particles.dim))
 
 
 def hat_moments(particles):
@@ -96,9 +101,11 @@ def hat_moments(particles):
     S0 = fem.LinearForm(lambda v, w: v).assemble(basis)
     S1 = np.array([fem.LinearForm(lambda v, w, a=a: v * w.x[a])
                    .assemble(basis) for a in range(d)]).T
-    S2 = np.array([[fem.LinearForm(lambda v, w, a=a, b=b: v * w.x[a]
-                                   * w.x[b]).assemble(basis)
-                    for b in range(d)] for a in range(d)]).transpose(2, 0, 1)
+    S2 = np.empty((len(S0), d, d))
+    for a in range(d):  # d(d+1)/2 assemblies, the rest by symmetry
+        for b in range(a, d):
+            S2[:, a, b] = S2[:, b, a] = fem.LinearForm(
+                lambda v, w, a=a, b=b: v * w.x[a] * w.x[b]).assemble(basis)
     V = np.where(S0 > 0, S0, 1.0)
     Xc = np.where(S0[:, None] > 0, S1 / V[:, None], particles.x.T)
     M2 = S2 / V[:, None, None] - Xc[:, :, None] * Xc[:, None, :]
@@ -144,8 +151,7 @@ def moment_quadrature(particles, families, n=1, moments=None):
                 P, families.masters[small[0]], families.sizes[small[0]]))
     x, V = particles.x, particles.volumes
     at_master = x.T[families.masters][:, None, :]
-    Gp, _ = wte2_at(x, V, families, np.concatenate([pts, at_master], 1),
-                    n=n)
+    Gp = wte2_at(x, V, families, np.concatenate([pts, at_master], 1), n=n)
     G = np.zeros((nf, m, m, d))
     G[:, :P] = Gp[:, :P]
     dx = np.zeros((nf, m))
@@ -159,5 +165,5 @@ def moment_quadrature(particles, families, n=1, moments=None):
     return G, dx, values, points, Gp[:, P]
 
 
-__all__ = ["MIN_MEMBERS", "default_families", "hat_moments",
+__all__ = ["MIN_MEMBERS", "default_families", "family_options", "hat_moments",
            "moment_points", "moment_quadrature"]

@@ -51,7 +51,7 @@ import skfem as fem
 from ..discretization import families as families_mod
 from ..discretization import petrov
 from ..discretization import recipes
-from ..discretization.moment_quadrature import MIN_MEMBERS, hat_moments
+from ..discretization.moment_quadrature import family_options, hat_moments
 from ..discretization.basis import FamilyBasis
 from ..discretization.families import Families
 from ..discretization.particles import Particles
@@ -248,10 +248,13 @@ class Partition:
             min_size=min_size, order=order)
         if pairwise:
             ring = petrov.pairwise(ring)
+        return _subset(ring, self._owned_active())
+
+    def _owned_active(self):
+        """Boolean over the particles: owned by this rank, and active."""
         mine = np.zeros(self.n, dtype=bool)
         mine[self.owned] = True
-        mine &= self.particles.active
-        return _subset(ring, mine)
+        return mine & self.particles.active
 
     def restricted(self, elements):
         """This partition with its particles collocated from the cells
@@ -310,8 +313,7 @@ class Partition:
         fam = error = None
         try:  # an error here is raised on every rank (no rank left waiting)
             if rule == "moments":  # the serial default_families, per rank
-                fam = self.families(
-                    min_size=MIN_MEMBERS[self.particles.dim], order=2)
+                fam = self.families(**family_options(self.particles.dim))
             else:
                 fam = (families if rule is None
                        else self.families(pairwise=method == "PPG1")
@@ -382,10 +384,8 @@ class Partition:
         (:data:`~skfem_pg.discretization.families.NEAREST` neighbours,
         pairwise, with ties), in global particle numbers: built on the
         replicated particle positions, so the same as serial."""
-        fam = families_mod.build("nearest", self.particles)
-        mine = np.zeros(self.n, dtype=bool)
-        mine[self.owned] = True
-        return _subset(fam, mine & self.particles.active)
+        return _subset(families_mod.build("nearest", self.particles),
+                       self._owned_active())
 
     def _local_particles(self, fam, local=None):
         """The local particles of a basis of the families ``fam``: owned,

@@ -57,25 +57,21 @@ def taylor2_derivatives(D):
 
 def wte2_gradients(x, volumes, fam, n=1):
     """WTE2 derivatives, shape ``(nf, m, m, d)`` (U2)."""
-    return wte2_at(x, volumes, fam, n=n)[0]
+    return wte2_at(x, volumes, fam, n=n)
 
 
 def wte2_at(x, volumes, fam, points=None, n=1):
-    r"""The WTE2 fit of each family evaluated at ``points``: derivatives
-    ``G[k, j, i]`` and values ``N[k, j, i]`` of the shape function of
-    member ``i`` at point ``j`` of family ``k``, shapes ``(nf, P, m, d)``
-    and ``(nf, P, m)``; ``points`` ``(nf, P, d)`` absolute positions
-    (default: the members, ``P = m``).  The values are
-    :math:`N^{kji} = c^{ki}\cdot p(y^j - X^k)` for :math:`i \ne k` and
-    :math:`1 - \sum_{i\ne k} N^{kji}` for the master (the expansion
-    interpolates it); both are exact for quadratic fields."""
+    r"""The WTE2 fit of each family differentiated at ``points``:
+    ``G[k, j, i]``, the derivative of the shape function of member ``i``
+    at point ``j`` of family ``k``, shape ``(nf, P, m, d)``; ``points``
+    ``(nf, P, d)`` absolute positions (default: the members, ``P = m``).
+    Exact for quadratic fields."""
     mem_all, mask_all = fam.padded()
     nf, m = mem_all.shape
     d = x.shape[0]
     q = d + d * (d + 1) // 2
     P = m if points is None else points.shape[1]
     G = np.zeros((nf, P, m, d))
-    N = np.zeros((nf, P, m))
     for sl in chunks(nf, max(m, P) * m * q):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
         D = geo.D0
@@ -97,8 +93,5 @@ def wte2_at(x, volumes, fam, points=None, n=1):
         g = np.einsum("kiq,kjqd->kjid", c, dp)
         g[:, :, 0] = -g[:, :, 1:].sum(axis=2)
         g /= geo.h[:, None, None, None]
-        v = np.einsum("kiq,kjq->kji", c, taylor2_basis(Y)) * at[..., None]
-        v[:, :, 0] = at - v[:, :, 1:].sum(axis=2)
         G[sl] = g * geo.mask[:, None, :, None]
-        N[sl] = v * geo.mask[:, None, :]
-    return G, N
+    return G
