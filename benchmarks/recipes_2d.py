@@ -57,9 +57,10 @@ RESULTS = [os.path.join(HERE, "README.md"),
 FORM = linear_elasticity(100.0, 40.0)
 
 
-def occ_mesh(build, size, quad=False, order=1):
+def occ_mesh(build, size, quad=False, order=1, size_at=None):
     """A gmsh mesh of the OpenCASCADE geometry ``build(occ)``: triangles,
-    or recombined quadrilaterals (``quad``), of size ``size``."""
+    or recombined quadrilaterals (``quad``), of size ``size``, or graded:
+    ``size * size_at(x, y)`` (``size_at`` at most 1)."""
     import gmsh
     gmsh.initialize(interruptible=False)
     try:
@@ -68,8 +69,15 @@ def occ_mesh(build, size, quad=False, order=1):
         gmsh.model.occ.synchronize()
         gmsh.model.addPhysicalGroup(
             2, [e[1] for e in gmsh.model.getEntities(2)], 1)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * size)
+        if size_at is None:
+            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.5 * size)
+        else:
+            gmsh.model.mesh.setSizeCallback(
+                lambda dim, tag, x, y, z, lc: size * size_at(x, y))
+            for option in ("ExtendFromBoundary", "FromPoints",
+                           "FromCurvature"):
+                gmsh.option.setNumber("Mesh.MeshSize" + option, 0)
         if quad:
             gmsh.option.setNumber("Mesh.RecombineAll", 1)
             gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)

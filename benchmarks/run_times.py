@@ -142,6 +142,10 @@ SCRIPTS = [
      "2-D recipes (family rule, weights, bond weight exponent) against "
      "T1/Q1: four elastic geometries on triangles and quadrilaterals, "
      "Poisson, against T2 overkills", "6 min", 360),
+    ("stress_hole", ["benchmarks/stress_hole.py"],
+     "particle stresses at a hole against T1/Q1 nodal averages: Kirsch's "
+     "exact solution, an elliptic hole against a curved T2 overkill",
+     "2 min", 120),
     ("infsup_mixed", ["benchmarks/infsup_mixed.py"],
      "inf-sup values of the mixed PG pairs beside Q1P0, MINI (thesis Fig. "
      "7.15)", "1 min", 60),

@@ -22,12 +22,20 @@ def _embed3(F):
 
 
 def cauchy_and_von_mises(material, F):
-    """Cauchy stress ``(3, 3, ...)`` and von Mises stress ``(...)`` for
-    deformation gradients ``F`` (``(d, d, ...)``)."""
+    r"""Cauchy stress ``(3, 3, ...)`` and von Mises stress ``(...)`` for
+    deformation gradients ``F`` (``(d, d, ...)``): :math:`PF^T/J`, or the
+    material's stress itself for a small-strain law
+    (``material.small_strain``, :class:`~skfem_pg.materials.LinearElastic`;
+    with its ``plane_stress``, :math:`\sigma_{zz} = 0` in 2-D)."""
     F3 = _embed3(F)
     P = material.stress(F3)
-    J = np.linalg.det(np.moveaxis(F3, (0, 1), (-2, -1)))
-    sigma = np.einsum("iK...,jK...->ij...", P, F3) / J
+    if getattr(material, "small_strain", False):
+        sigma = P.copy()
+        if F.shape[0] == 2 and getattr(material, "plane_stress", False):
+            sigma[2, 2] = 0.0  # the embedding's F_zz = 1 is plane strain
+    else:
+        J = np.linalg.det(np.moveaxis(F3, (0, 1), (-2, -1)))
+        sigma = np.einsum("iK...,jK...->ij...", P, F3) / J
     s = sigma - np.trace(sigma) / 3.0 * np.eye(3).reshape(
         (3, 3) + (1,) * (sigma.ndim - 2))
     return sigma, np.sqrt(1.5 * np.einsum("ij...,ij...->...", s, s))

@@ -238,3 +238,28 @@ def quadratic_patch_test(mesh, neumann, E=100.0, nu=0.3, **basis_kwargs):
         "basis": basis,
         "u": u,
     }
+
+
+def kirsch_displacement(x, lam, mu, radius=1.0):
+    r"""Kirsch's solution: the displacements ``(2, ...)`` at ``x``
+    ``(2, ...)`` of an infinite plate in plane strain with a traction-free
+    circular hole of ``radius`` about the origin, under unit tension in
+    :math:`x` far away (Lamé ``lam``, ``mu``); its hoop stress on the hole
+    is :math:`1 - 2\cos 2\theta`, 3 at :math:`\theta = \pm\pi/2`.  On a
+    finite part of the plate with these displacements on its outer
+    boundary it is the exact solution of a stress concentration.
+
+    >>> import numpy as np
+    >>> u = kirsch_displacement(np.array([[2.0], [0.0]]), 1.5, 1.0)
+    >>> float(np.round(u[1, 0], 12))  # on the x axis: no u_y
+    0.0
+    """
+    kappa = 3 - 2 * lam / (lam + mu)  # plane strain: 3 - 4 nu
+    a2 = radius ** 2
+    r, t = np.hypot(x[0], x[1]), np.arctan2(x[1], x[0])
+    c, s = np.cos(2 * t), np.sin(2 * t)
+    ur = (r * ((kappa - 1) / 2 + c) + a2 / r * (1 + (1 + kappa) * c)
+          - a2 ** 2 / r ** 3 * c) / (4 * mu)
+    ut = ((1 - kappa) * a2 / r - r - a2 ** 2 / r ** 3) * s / (4 * mu)
+    return np.array([ur * np.cos(t) - ut * np.sin(t),
+                     ur * np.sin(t) + ut * np.cos(t)])

@@ -77,7 +77,13 @@ def _identity4(F):
 
 
 class Material:
-    """Base class: ``stress(F)``, ``tangent(F)``, ``energy(F)``."""
+    """Base class: ``stress(F)``, ``tangent(F)``, ``energy(F)``.
+
+    ``small_strain`` is true for a law whose ``stress`` is the small-strain
+    stress itself (output reports it as the Cauchy stress, without the push
+    forward :math:`PF^T/J` of a finite-strain law)."""
+
+    small_strain = False
 
     def stress(self, F):
         raise NotImplementedError
@@ -99,8 +105,11 @@ class LinearElastic(Material):
     :math:`\varepsilon = \mathrm{sym}(F - I)`,
     :math:`P = \lambda\,\mathrm{tr}\varepsilon\, I + 2\mu\varepsilon`."""
 
+    small_strain = True
+
     def __init__(self, lam, mu, plane_stress=False):
         lam, mu = check_moduli(lam=lam, mu=mu)
+        self.plane_stress = bool(plane_stress)
         if plane_stress:
             lam = 2 * lam * mu / (lam + 2 * mu)
         self.lam, self.mu = float(lam), float(mu)
