@@ -29,7 +29,9 @@ the moment-matched quadrature of the quadratic fit
 Each value is the signed compliance error f.u / f.u_ref - 1 in % (+ =
 soft, - = stiff); the reference is T2 on a finer mesh of the same
 geometry (its own error, estimated by the T2 one size coarser, is
-printed).  The ratio |e_PG| / |e_FE| at the finest node set is given
+printed).  T2 / Q2 on the same cells (about four times the unknowns)
+is the row to read per unknown: against PG on a node set with about four
+times the nodes.  The ratio |e_PG| / |e_FE| at the finest node set is given
 only where neither error changes sign under refinement.  One table per
 geometry into ``benchmarks/README.md`` and ``docs/guide/accuracy.md``
 (sections ``recipes_2d_*``).
@@ -182,6 +184,30 @@ def fe_element(mesh):
     return pg.particles.linear_elements(mesh)[0]
 
 
+#: the quadratic FE row of the tables: T2 / Q2 on the same cells
+QUADRATIC = "quadratic"
+
+
+def fe_basis(mesh, kw, vector):
+    """The FE basis of a table row: linear FE (``kw`` None) or quadratic
+    (``kw`` :data:`QUADRATIC`) on the node set's cells; else ``None``."""
+    if kw is None:
+        elem = fe_element(mesh)
+    elif kw is QUADRATIC:
+        elem = (fem.ElementTriP2() if isinstance(mesh, fem.MeshTri)
+                else fem.ElementQuad2())
+    else:
+        return None
+    return fem.Basis(mesh, fem.ElementVector(elem) if vector else elem)
+
+
+def unknowns_ratio(mesh):
+    """Unknowns of quadratic FE over the vertices' on ``mesh``."""
+    e2 = (fem.ElementTriP2() if isinstance(mesh, fem.MeshTri)
+          else fem.ElementQuad2())
+    return fem.Basis(mesh, e2).N / mesh.nvertices
+
+
 def _dirichlet(basis, mesh, clamps):
     D = []
     for select, comps in clamps:
@@ -241,16 +267,19 @@ def table(title, kinds, compliance, reference):
     printed and returned as markdown."""
     lines = []
     for kind, meshes in kinds.items():
-        fe_name = "T1" if isinstance(meshes[0], fem.MeshTri) else "Q1"
+        tri = isinstance(meshes[0], fem.MeshTri)
+        fe_name = "T1" if tri else "Q1"
+        fe2_name = "{} ({:.1f}x the unknowns)".format(
+            "T2" if tri else "Q2", unknowns_ratio(meshes[-1]))
+        runs = {fe_name: None, fe2_name: QUADRATIC, **VARIANTS}
         nodes = [int(m.nvertices) for m in meshes]
         rows, fe_err = [], None
-        for name in [fe_name] + list(VARIANTS):
+        for name, kw in runs.items():
             errs, secs = [], 0.0
             for m in meshes:
                 t0 = time.perf_counter()
                 try:
-                    c = compliance(m, None if name == fe_name
-                                   else VARIANTS[name])
+                    c = compliance(m, kw)
                     errs.append(100 * (c / reference - 1))
                 except (pg.FamilyError, pg.CorrectionError) as err:
                     print("   ", name, nodes, type(err).__name__, err)
@@ -263,8 +292,9 @@ def table(title, kinds, compliance, reference):
                         + [ratio, "{:.2f}".format(secs)])
             print("  {:50s}".format(name) + " ".join(
                 "{:+8.2f}".format(e) for e in errs), ratio, flush=True)
-        lines.append("**{}, {}** ({} nodes; FE = {})\n\n".format(
-            title, kind, " / ".join(map(str, nodes)), fe_name)
+        lines.append("**{}, {}** ({} nodes; FE = {}; {} on the same "
+                     "cells)\n\n".format(title, kind, " / ".join(
+                         map(str, nodes)), fe_name, fe2_name)
             + markdown_table(["method"] + ["{} nodes".format(n)
                                            for n in nodes]
                              + ["PG/FE at the finest", "time [s]"], rows))
@@ -299,8 +329,9 @@ def elastic_study(name):
                                           (2, 4, 8, 16)]
 
     def compliance(mesh, kw):
-        basis = (fem.Basis(mesh, fem.ElementVector(fe_element(mesh)))
-                 if kw is None else pg_basis(mesh, kw, 2))
+        basis = fe_basis(mesh, kw, True)
+        if basis is None:
+            basis = pg_basis(mesh, kw, 2)
         return elastic_compliance(basis, mesh, spec)
 
     text = ("`python benchmarks/recipes_2d.py --geometries {}`: signed "
@@ -325,8 +356,9 @@ def poisson_study():
                                          m))
 
         def compliance(mesh, kw):
-            basis = (fem.Basis(mesh, fe_element(mesh)) if kw is None
-                     else pg_basis(mesh, kw, None))
+            basis = fe_basis(mesh, kw, False)
+            if basis is None:
+                basis = pg_basis(mesh, kw, None)
             return poisson_compliance(basis, mesh)
 
         parts.append("Against T2 on {} nodes ({:+.1e} to {} nodes); on "

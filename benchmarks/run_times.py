@@ -142,6 +142,10 @@ SCRIPTS = [
      "2-D recipes (family rule, weights, bond weight exponent) against "
      "T1/Q1: four elastic geometries on triangles and quadrilaterals, "
      "Poisson, against T2 overkills", "6 min", 360),
+    ("gallery", ["benchmarks/gallery.py"],
+     "scikit-fem's ex03, ex11, ex22 with the basis swapped: FE against "
+     "the PG default and MQ on the same nodes, against overkills",
+     "2 min", 120),
     ("stress_hole", ["benchmarks/stress_hole.py"],
      "particle stresses at a hole against T1/Q1 nodal averages: Kirsch's "
      "exact solution, an elliptic hole against a curved T2 overkill",
