@@ -6,9 +6,10 @@ membrane (linear elasticity, lambda = 100, mu = 40, clamped at x = 0).
 Per node set and method, seconds for one solve of the condensed system:
 
 * ``pardiso`` — MKL PARDISO, symmetric indefinite mode on the upper
-  triangle (``skfem_pg.solvers.direct``; needs the ``[pardiso]`` extra);
-* ``superlu`` — the default install's direct solve (SuperLU, COLAMD,
-  what ``linear_solver("direct")`` uses in 3-D without PARDISO);
+  triangle (``skfem_pg.solvers.direct``; ``pypardiso``, in the default
+  install on x86-64 Linux and Windows);
+* ``superlu`` — SciPy's direct solve (SuperLU, COLAMD, what
+  ``linear_solver("direct")`` uses in 3-D without PARDISO);
 * ``amg`` — ``AMGSolver`` without extra candidates (rigid-body modes
   only): setup + CG to 1e-10;
 * ``amg+12`` — with ``PG_CANDIDATES`` = 12 smoothed random candidates

@@ -68,8 +68,9 @@ def submatrix(A, I):
 
 
 def pardiso_available():
-    """Whether ``pypardiso`` (Intel MKL PARDISO; ``pip install
-    skfem-pg[pardiso]``) can be imported."""
+    """Whether ``pypardiso`` (Intel MKL PARDISO; in the default install on
+    x86-64 Linux and Windows, elsewhere ``pip install skfem-pg[pardiso]``)
+    can be imported."""
     try:
         import pypardiso  # noqa: F401
     except ImportError:
@@ -298,7 +299,8 @@ def _symmetric(A, tol=1e-12):
 #: (``benchmarks/solvers_3d.py``; benchmarks/README.md, "Measurements behind
 #: the defaults").
 DIRECT_LIMIT = {2: 60_000, 3: 6_000}
-#: the same with MKL PARDISO (``[pardiso]`` extra; its symmetric LDL^T),
+#: the same with MKL PARDISO (the default install's on x86-64 Linux and
+#: Windows; its symmetric LDL^T),
 #: which also stops at :data:`DIRECT_NNZ_LIMIT_PARDISO` non-zeros.
 DIRECT_LIMIT_PARDISO = {2: 60_000, 3: 150_000}
 #: ``"auto"`` with PARDISO: the largest direct solve in non-zeros per
