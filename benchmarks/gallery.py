@@ -57,6 +57,19 @@ def signed(values, reference):
     return ["{:+.2f}".format(v) for v in 100 * (values / reference - 1)]
 
 
+def refinement_rows(label, meshes, measure, fe_basis, dim, reference):
+    """A row per mesh: its nodes and the signed errors of ``measure(basis,
+    mesh)`` with ``fe_basis(mesh)`` and each of :data:`VARIANTS`."""
+    rows = []
+    for m in meshes:
+        bases = [fe_basis(m)] + [pg.FamilyBasis(m, dim=dim, **kw)
+                                 for kw in VARIANTS.values()]
+        rows.append([m.nvertices] + signed(
+            np.array([measure(b, m) for b in bases]), reference))
+        print(label, rows[-1], flush=True)
+    return rows
+
+
 # -- ex03 ----------------------------------------------------------------
 def ex03():
     stiffness = elasticity(1.0, 1.0)
@@ -111,17 +124,10 @@ def ex11():
     refs = [energy(fem.Basis(m, fem.ElementVector(fem.ElementHex2())), m)
             for m in h2]
     print("ex11 overkill", refs, flush=True)
-    rows = []
-    for r in (1, 2, 3):
-        m = fem.MeshHex().refined(r)
-        row = [m.nvertices]
-        row += signed(np.array([energy(fem.Basis(m, fem.ElementVector(
-            fem.ElementHex1()), intorder=3), m)]), refs[1])
-        for kw in VARIANTS.values():
-            row += signed(np.array([energy(pg.FamilyBasis(m, dim=3, **kw),
-                                           m)]), refs[1])
-        rows.append(row)
-        print("ex11", row, flush=True)
+    rows = refinement_rows(
+        "ex11", [fem.MeshHex().refined(r) for r in (1, 2, 3)], energy,
+        lambda m: fem.Basis(m, fem.ElementVector(fem.ElementHex1()),
+                            intorder=3), 3, refs[1])
     write("ex11", "`python benchmarks/gallery.py --examples ex11`: strain "
           "energy, signed error in % against H2 on the cube refined three "
           "times ({:+.1e} from twice).\n\n".format(
@@ -139,16 +145,10 @@ def ex22():
 
     refs = [compliance(fem.Basis(m, fem.ElementTriP2()), m) for m in
             (fem.MeshTri.init_lshaped().refined(r) for r in (6, 7))]
-    rows = []
-    for r in (2, 3, 4):
-        m = fem.MeshTri.init_lshaped().refined(r)
-        row = [m.nvertices] + signed(np.array([compliance(
-            fem.Basis(m, fem.ElementTriP1()), m)]), refs[1])
-        for kw in VARIANTS.values():
-            row += signed(np.array([compliance(pg.FamilyBasis(m, **kw),
-                                               m)]), refs[1])
-        rows.append(row)
-        print("ex22", row, flush=True)
+    rows = refinement_rows(
+        "ex22", [fem.MeshTri.init_lshaped().refined(r) for r in (2, 3, 4)],
+        compliance, lambda m: fem.Basis(m, fem.ElementTriP1()), None,
+        refs[1])
     write("ex22", "`python benchmarks/gallery.py --examples ex22`: "
           "compliance f.u, signed error in % against P2 on the domain "
           "refined seven times ({:+.1e} from six).\n\n".format(

@@ -5,7 +5,8 @@ free-block spectra (``spectrum``), the numerical inf-sup test
 from .verification import (l2_error, h1_error, nodal_interpolant,
                            discrete_energy, energy_capture,
                            linear_patch_test, quadratic_patch_test,
-                           kirsch_displacement, PATCH_GRADIENT_2D, PATCH_GRADIENT_3D)
+                           kirsch_displacement, PATCH_GRADIENT_2D,
+                           PATCH_GRADIENT_3D)
 
 __all__ = ["l2_error", "h1_error", "nodal_interpolant", "discrete_energy",
            "energy_capture", "linear_patch_test", "quadratic_patch_test",
