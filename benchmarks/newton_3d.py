@@ -28,13 +28,14 @@ DEMOS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..",
                      "demos")
 
 
-def cook_scene(mesh):
+def cook_demo():
+    """``demos/cook_3d.py`` as a module (its meshes and scene)."""
     import importlib.util
     spec = importlib.util.spec_from_file_location(
         "cook_3d", os.path.join(DEMOS, "cook_3d.py"))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    return mod, mod.scene(mesh)
+    return mod
 
 
 class Timed:
@@ -129,12 +130,12 @@ def main():
         if kind == "tet":
             mesh = pg.meshing.from_geo(pg.meshing.geo_path("cook3d.geo"),
                                        size=size)
-            mod, sc = cook_scene(mesh.with_boundaries(
+            sc = cook_demo().scene(mesh.with_boundaries(
                 {"left": lambda x: np.isclose(x[0], 0),
                  "right": lambda x: np.isclose(x[0], 48)}))
             fe = "O1"
         else:
-            mod, _ = cook_scene(None)
+            mod = cook_demo()
             mesh = mod.cook3d(size, size // 4, distortion=0.3)
             sc = mod.scene(mesh)
             fe = "H1P0"
