@@ -123,6 +123,9 @@ SCRIPTS = [
     ("newton_3d", ["benchmarks/newton_3d.py"],
      "one 3-D Newton iteration, PG vs O1 / H1P0: material, assembly, "
      "solve", "20 min", 1200),
+    ("factor_reuse", ["benchmarks/factor_reuse.py"],
+     "modified Newton (reuse=True) against full Newton: whole solves of "
+     "the 3-D Cook, a bracket, necking, the punch", "5 min", 600),
     ("scale_3d", ["benchmarks/scale_3d.py"],
      "3-D linear elasticity from mesh to solution up to 100k particles, "
      "peak memory", "15 min", 900),

@@ -1,6 +1,7 @@
 """The batched assembly equals scikit-fem's generic assembly."""
 import numpy as np
 import pytest
+import scipy.sparse as sp
 import skfem as fem
 from skfem.helpers import dot, grad, ddot, sym_grad, transpose, mul
 
@@ -22,6 +23,15 @@ def test_elasticity_fast_equals_generic(mesh):
     b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=d)
     form = linear_elasticity(*lame(10.0, 0.3))
     assert rel(pg.assemble(form, b), form.assemble(b)) < 1e-13
+    # a point-wise tangent (the gradients-only path through the basis'
+    # cached transposed gradients, weights folded into the coefficients)
+    from skfem_pg.materials import NeoHooke
+    from skfem_pg.formulations import material_tangent
+    F = b.interpolate(0.05 * np.random.default_rng(2).standard_normal(
+        b.N)).grad + np.eye(d)[:, :, None, None]
+    A = NeoHooke(3.0, 1.0).tangent(F)
+    assert rel(pg.assemble(material_tangent, b, A=A),
+               material_tangent.assemble(b, A=A)) < 1e-13
 
 
 def test_scalar_and_value_terms():
@@ -117,3 +127,47 @@ def test_fe_cell_bases_fast_equals_generic(mesh_elem):
 
     assert rel(pg.assemble(mass_diffusion, sb),
                mass_diffusion.assemble(sb)) < 1e-13
+
+
+@pytest.mark.parametrize("transposed", [False, True])
+@pytest.mark.parametrize("mesh,dim", [(square(5, 0.3), 2), (square(4, 0.3), None),
+                                      (cube(2, 0.3), 3)])
+def test_local_matrices_scatter_like_coo(mesh, dim, transposed):
+    """:func:`assemble_local` through the cached entry index equals a COO
+    sum of the same local matrices, in both layouts, on a basis with
+    several family sizes; the returned matrix is canonical CSR and does
+    not share the cached index arrays."""
+    from skfem_pg.discretization.assembly import assemble_local, \
+        batched_view
+    b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=dim)
+    view = batched_view(b)
+    assert len(view.blocks) > 1  # several size groups: several chunks
+    nc = view.nc
+    rng = np.random.default_rng(3)
+    local = [rng.standard_normal((blk.ne, nc, blk.nloc, nc, blk.nloc)
+                                 if transposed else
+                                 (blk.ne, blk.nloc, blk.nloc, nc, nc))
+             for blk in view.blocks]
+
+    def local_matrices(bi, blk, sl):
+        return local[bi][sl]
+
+    rows, cols, vals = [], [], []
+    for blk, K in zip(view.blocks, local):
+        if transposed:  # [k, c_i, i, c_l, l] -> [k, l, i, c_l, c_i]
+            K = K.transpose(0, 4, 2, 3, 1)
+        dof = nc * blk.conn[:, :, None] + np.arange(nc)  # (k, node, c)
+        r = np.broadcast_to(dof[:, :, None, :, None], K.shape)
+        c = np.broadcast_to(dof[:, None, :, None, :], K.shape)
+        rows.append(r.ravel())
+        cols.append(c.ravel())
+        vals.append(K.ravel())
+    ref = sp.coo_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                np.concatenate(cols))),
+                        shape=(b.N, b.N)).tocsr()
+    for _ in range(2):  # the second call through the cached index
+        A = assemble_local(b, local_matrices, view, transposed=transposed)
+        assert A.has_canonical_format
+        assert abs(A - ref).max() <= 1e-13 * abs(ref).max()
+        A.indices[:] = 0  # the caller's copy: the cache is untouched
+        A.indptr[:] = 0

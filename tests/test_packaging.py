@@ -38,8 +38,9 @@ def test_geo_sources_are_kept_once():
     assert inside == []
     top = sorted(f for f in os.listdir(os.path.join(ROOT, "meshes"))
                  if f.endswith(".geo"))
-    assert top == ["beam3d.geo", "cook.geo", "cook3d.geo", "cube.geo",
-                   "plate_hole3d.geo", "plate_two_holes.geo", "square.geo"]
+    assert top == ["beam3d.geo", "bracket.geo", "cook.geo", "cook3d.geo",
+                   "cube.geo", "plate_hole3d.geo", "plate_two_holes.geo",
+                   "square.geo"]
 
 
 def test_geo_path_finds_every_source_and_names_a_missing_one():

@@ -255,14 +255,16 @@ def test_direct_solver_paths(kind):
     b = rng.standard_normal(A.shape[0])
     from unittest import mock
     from skfem_pg.solvers import linear
-    spsolve = linear.spl.spsolve
-    with mock.patch.object(linear.spl, "spsolve",
-                           side_effect=spsolve) as partial:
+    splu = linear.spl.splu
+    with mock.patch.object(linear.spl, "splu", side_effect=splu) as lu:
         x = pg.solvers.direct(A, b, ordering="rcm+mmd")
     assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
-    # spsolve (partial pivoting) only for saddle points and where diagonal
-    # pivots fail
-    assert partial.called == (kind in ("saddle", "needs pivoting"))
+    # partial pivoting (SuperLU's default threshold) only for saddle points
+    # (COLAMD) and where diagonal pivots fail
+    partial = [c for c in lu.call_args_list
+               if "diag_pivot_thresh" not in c.kwargs]
+    assert bool(partial) == (kind in ("saddle", "needs pivoting"))
+    assert len(lu.call_args_list) == 1 + (kind == "needs pivoting")
 
 
 def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
@@ -430,3 +432,91 @@ def test_pardiso_nearly_incompressible_newton_equals_superlu(name, nu,
     monkeypatch.setattr(linear, "pardiso_available", lambda: False)
     v = sc.solve(name).u
     assert np.abs(u - v).max() <= 1e-8 * np.abs(v).max()
+
+
+@pytest.mark.parametrize("solver", ["direct", "superlu"])
+def test_modified_newton_equals_full_newton(beam, solver):
+    """reuse=True (kept factorizations) reaches full Newton's answer to
+    1e-10 on a bent PG cantilever in large deflection (tip > 1/4 of the
+    length), with fewer fresh tangents than increments; prescribed
+    displacements ride on kept factors too."""
+    from skfem_pg.solvers.linear import Factorization
+    mesh, b = beam
+    f = pg.traction(b, "right", [0.0, -0.6])
+    D = b.get_dofs("left")
+    lin = solver if solver == "direct" else linear_solver("direct")
+    if solver == "superlu":  # the scipy path of the kept factorization
+        lin.factorize = lambda A: Factorization(A, "rcm+mmd")
+    kw = dict(D=D, steps=4, tol=1e-12, verbose=False, solver=lin)
+    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    u, hist = newton(model, f, **kw)
+    v, kept = newton(model, f, reuse=True, **kw)
+    assert np.abs(v - u).max() <= 1e-10 * np.abs(u).max()
+    assert np.abs(u).max() > 1.0  # large deflection
+    tangents = sum(h["tangents"] for h in kept)
+    increments = sum(len(h["residuals"]) - 1 for h in kept)
+    assert 0 < tangents < increments
+    # a prescribed tip displacement in steps: the first increment of each
+    # step carries it (K_ID du_D by the kept tangent)
+    tip = b.get_dofs("right").nodal["u^2"]
+    u_D = np.zeros(b.N)
+    u_D[tip] = -1.0
+    DD = np.union1d(D.flatten(), tip)
+    kw.update(D=DD, u_D=u_D)
+    u, _ = newton(model, **kw)
+    v, kept = newton(model, reuse=True, **kw)
+    assert np.abs(v - u).max() <= 1e-10 * np.abs(u).max()
+    assert np.allclose(v[tip], -1.0)
+
+
+def test_modified_newton_without_kept_factors_is_newton(beam):
+    """A solver without a kept factorization (a user's callable) makes
+    reuse=True plain Newton: every increment a fresh tangent."""
+    mesh, b = beam
+    f = pg.traction(b, "right", [0.0, -0.01])
+    D = b.get_dofs("left")
+    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    u, hist = newton(model, f, D=D, verbose=False,
+                     solver=lambda A, r: pg.solvers.direct(A, r))
+    v, kept = newton(model, f, D=D, verbose=False, reuse=True,
+                     solver=lambda A, r: pg.solvers.direct(A, r))
+    assert np.array_equal(u, v)
+    assert [h["tangents"] for h in kept] \
+        == [len(h["residuals"]) - 1 for h in hist]
+
+
+@pytest.mark.parametrize("ordering", ["pardiso", "rcm+mmd", "colamd"])
+def test_factorization_solves_many_right_hand_sides(ordering):
+    """A kept Factorization solves several right-hand sides exactly; on a
+    symmetric indefinite matrix PARDISO's Cholesky attempt falls back to
+    LDL^T (and says so: definite False)."""
+    from skfem_pg.solvers import Factorization
+    if ordering == "pardiso" and not pg.solvers.pardiso_available():
+        pytest.skip("pypardiso is not installed")
+    rng = np.random.default_rng(5)
+    n = 80
+    R = sp.random(n, n, density=0.1, random_state=rng)
+    for shift, definite in ((20.0, True), (-3.0, False)):
+        A = (R + R.T + shift * sp.eye(n)).tocsr()
+        if not definite:  # make sure of a negative eigenvalue
+            assert np.linalg.eigvalsh(A.toarray()).min() < 0
+        f = Factorization(A, ordering)
+        for _ in range(3):
+            b = rng.standard_normal(n)
+            x = f.solve(b)
+            assert np.abs(A @ x - b).max() <= 1e-10 * np.abs(b).max()
+        if ordering == "pardiso":
+            assert f.definite is definite
+        f.free()
+    with pytest.raises(ValueError, match="ordering"):
+        Factorization(A, "umfpack")
+
+
+def test_solver_docstring_examples_run():
+    """The examples in the Newton and linear solver docstrings are what
+    the code gives."""
+    import doctest
+    from skfem_pg.solvers import linear, static
+    for module in (linear, static):
+        result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+        assert result.attempted > 0 and result.failed == 0, module

@@ -364,28 +364,44 @@ def _assemble_bilinear(form, basis, view, vview, kwargs, local_extra=None):
         sel = [a * nch + b for a in range(nc) for b in ch]
         C = C[..., sel, :][..., :, sel]
     nb = len(ch)
-    Cb = {}  # coefficients per block
+    gradients_only = ch == list(range(1, nch))
+    Cb = {}  # weighted coefficients per block
+
+    def weighted(Cq, dx):
+        """``w_kj C[k, j]`` as ``(ne, nq, c·nb, c·nb)``, a new array."""
+        Cq = np.asarray(Cq)
+        Cq = Cq.reshape(Cq.shape[:2] + (nc * nb, nc * nb))
+        w = dx[:, :, None, None]
+        if np.may_share_memory(Cq, C) or Cq.shape[:2] != dx.shape:
+            return Cq * w
+        Cq *= w  # the block's own gather: weighted in place
+        return Cq
 
     def local_matrices(bi, blk, sl):
         Gh = blk.ext_grad(sl, ch)  # trial (k, j, i, β)
         Gv = Gh if vview is view else vview.blocks[bi].ext_grad(sl, ch)
         nfc, nq, m = Gh.shape[:3]
-        # GT[k, i, (j, β)] = w_kj Ĝ[k, j, i, β]
-        GT = (Gh * blk.dx[sl][:, :, None, None]).transpose(0, 2, 1, 3) \
-            .reshape(nfc, 1, m, nq * nb)
-        # Ca[k, a, j, (β, c), γ] = C[k, j, (a, β), (c, γ)]
+        # GT[k, i, (j, β)] = Ĝ[k, j, i, β]: a view of the basis' cached
+        # transposed gradients where the form uses the gradients only
+        if gradients_only and blk.grad_t is not None:
+            GT = np.swapaxes(blk.grad_t(sl), -1, -2)[:, None]
+        else:
+            GT = Gh.transpose(0, 2, 1, 3).reshape(nfc, 1, m, nq * nb)
+        # Ca[k, a, j, (β, c), γ] = w_kj C[k, j, (a, β), (c, γ)]
         if const:
-            Ca = C.reshape(1, nc, 1, nb * nc, nb)
+            Cw = weighted(C.reshape(1, 1, -1), blk.dx[sl])
         else:
             if bi not in Cb:
                 Cb.clear()
-                Cq = blk.take(C)  # one gather, contiguous
-                Cb[bi] = Cq.reshape(Cq.shape[:2] + (nc * nb, nc * nb))
-            Ca = Cb[bi][sl].reshape(nfc, nq, nc, nb * nc, nb).transpose(
-                0, 2, 1, 3, 4)
+                Cb[bi] = weighted(blk.take(C), blk.dx)  # one gather
+            Cw = Cb[bi][sl]
+        Ca = Cw.reshape(nfc, nq, nc, nb * nc, nb).transpose(0, 2, 1, 3, 4)
         # Y[k, a, (j, β), (c, l)]
         #     = sum_γ Ca[k, a, j, (β, c), γ] Ĝv[k, j, l, γ]  (test)
-        Y = np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None])
+        # (written C-ordered: numpy would follow Ca's strides and the
+        # reshape below would copy)
+        Y = np.matmul(Ca, np.swapaxes(Gv, -1, -2)[:, None],
+                      out=np.empty((nfc, nc, nq, nb * nc, m)))
         Y = Y.reshape(nfc, nc, nq * nb, nc * m)
         # K[k, a, i, c, l]
         #     = sum_{j, β} GT[k, i, (j, β)] Y[k, a, (j, β), (c, l)]
@@ -395,6 +411,66 @@ def _assemble_bilinear(form, basis, view, vview, kwargs, local_extra=None):
         return K
 
     return assemble_local(basis, local_matrices, view, transposed=True)
+
+
+def entry_index(basis, view=None, transposed=False):
+    """Where each local entry goes in the CSR data of the assembled matrix,
+    computed once per layout and cached on the basis (beside
+    :func:`block_pattern`): per chunk of :func:`block_pattern` ``(lo,
+    idx)``, ``idx`` (int32 where it fits) the CSR data position minus
+    ``lo`` of every entry of the chunk's local matrices in
+    :func:`assemble_local`'s layout (``transposed``: ``[k, c_i, i, c_l,
+    l]``, else ``[k, l, i, c_l, c_i]``), so a chunk is summed into the
+    data by one ``bincount`` over ``[lo, lo + idx.max()]`` with no copy
+    of its local matrices; and the CSR ``indptr`` / ``indices`` of the
+    ``N × N`` matrix (component ``c`` of node ``n`` is dof ``nc·n + c``).
+
+    The index holds one integer per local entry: about the memory of the
+    assembled matrix itself (3 local entries per non-zero on 3-D kNN
+    families)."""
+    cache = getattr(basis, "_entry_index", None)
+    if cache is None:
+        cache = basis._entry_index = {}
+    if transposed in cache:
+        return cache[transposed]
+    view = batched_view(basis) if view is None else view
+    nc = view.nc
+    indptr, indices, pieces = block_pattern(basis, view)
+    n = len(indptr) - 1
+    indptr = indptr.astype(np.int64)
+    rowlen = np.diff(indptr)
+    brow = np.repeat(np.arange(n), rowlen)
+    # CSR position of component (0, 0) of node-level entry e and the
+    # distance between the component rows of its node row
+    base = nc * nc * indptr[brow] + (np.arange(len(indices))
+                                     - indptr[brow]) * nc
+    stride = nc * rowlen[brow]
+    nnz = nc * nc * len(indices)
+    dtype = np.int32 if nnz < 2 ** 31 else np.int64
+    comp = np.arange(nc)
+    out = []
+    for bi, sl, u, inv in pieces:
+        m = view.blocks[bi].nloc
+        e = u[inv].reshape(-1, m, m)  # [k, l, i]
+        if transposed:  # [k, c_i, i, c_l, l]
+            e = e.transpose(0, 2, 1)[:, None, :, None, :]
+            pos = base[e] + comp[:, None] * stride[e] \
+                + comp[:, None, None, None]
+        else:  # [k, l, i, c_l, c_i]
+            e = e[..., None, None]
+            pos = base[e] + comp[:, None] * stride[e] + comp
+        lo = int(pos.min())
+        out.append((lo, (pos - lo).astype(dtype).ravel()))
+    csr_indptr = np.empty(nc * n + 1, dtype=dtype)
+    csr_indptr[:-1] = (nc * nc * indptr[:-1, None]
+                       + comp * nc * rowlen[:, None]).ravel()
+    csr_indptr[-1] = nnz
+    csr_indices = np.empty(nnz, dtype=indices.dtype)
+    at = base[:, None, None] + comp[:, None] * stride[:, None, None] + comp
+    csr_indices[at] = (nc * indices[:, None, None] + comp).astype(
+        indices.dtype)
+    cache[transposed] = (out, csr_indptr, csr_indices)
+    return cache[transposed]
 
 
 @kernel
@@ -410,30 +486,22 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     ``[c_l, c_i]``.  With ``transposed=True`` it returns the
     component-major transpose ``(ne, c, m, c, m)`` indexed
     ``[k, c_i, i, c_l, l]`` instead (what a batched product yields
-    without a strided copy).  Entries are summed into the cached
-    :func:`block_pattern` by the chunk's node-pair indices, one
-    ``bincount`` per component pair (an entry-level index would hold
-    ``c²`` times the integers).
+    without a strided copy).  Each chunk's entries are summed into the
+    CSR data by one ``bincount`` through the cached :func:`entry_index`
+    (no copy of the local matrices).
     """
     view = batched_view(basis) if view is None else view
     nc = view.nc
-    indptr, indices, pieces = block_pattern(basis, view)
-    data = np.zeros((len(indices), nc, nc))
-    for bi, sl, u, inv in pieces:
+    pieces = block_pattern(basis, view)[2]
+    index, indptr, indices = entry_index(basis, view, transposed)
+    data = np.zeros(int(indptr[-1]))
+    for (bi, sl, _, _), (lo, idx) in zip(pieces, index):
         K = local_matrices(bi, view.blocks[bi], sl)
-        if transposed:  # [k, c_i, i, c_l, l] -> [k, l, i, c_l, c_i]
-            K = K.transpose(0, 4, 2, 3, 1)
-        # one bincount per component pair over the chunk's block
-        # indices: no entry-level index is kept (nc² times the memory)
-        for a in range(nc):
-            for c in range(nc):
-                data[u, a, c] += np.bincount(
-                    inv, weights=K[..., a, c].ravel(), minlength=len(u))
+        part = np.bincount(idx, weights=K.ravel())
+        data[lo:lo + len(part)] += part
     N = basis.N
-    if nc == 1:
-        return sp.csr_matrix((data.ravel(), indices, indptr), shape=(N, N))
-    return sp.bsr_matrix((data, indices, indptr),
-                         shape=(N, N)).tocsr()
+    return sp.csr_matrix((data, indices.copy(), indptr.copy()),
+                         shape=(N, N))
 
 
 def _assemble_linear(form, basis, view, kwargs):

@@ -137,6 +137,11 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
     iterations, minimum J, seconds).
     """
     opts = NewtonControls.of(controls, defaults=DISTRIBUTED_DEFAULTS, **kw)
+    if opts.reuse:
+        raise NotImplementedError(
+            "reuse=True (modified Newton with kept factors) is serial: the "
+            "distributed Newton refactorizes PETSc's preconditioner every "
+            "iteration; drop reuse=")
     if getattr(model, "N", None) != getattr(model, "n_u", model.N):
         raise NotImplementedError(
             "{} has global extra fields; the distributed Newton solves "

@@ -3,7 +3,7 @@ method with adaptive load steps that drives any formulation (and commits
 the history of plastic models per converged step), checkpoints; dynamics:
 lumped mass, implicit Newmark, explicit central differences, a rigid
 frictionless wall, energy bookkeeping."""
-from .linear import (direct, linear_solver, AMGSolver, rigid_body_modes,
+from .linear import (direct, Factorization, linear_solver, AMGSolver, rigid_body_modes,
                      pardiso_available, DIRECT_LIMIT,
                      DIRECT_LIMIT_PARDISO, DIRECT_NNZ_LIMIT_PARDISO,
                      auto_direct_limit, submatrix)
@@ -18,7 +18,7 @@ from .explicit import (central_difference, stable_time_step,
 from . import checkpoint
 from ..dofs import as_dofs
 
-__all__ = ["direct", "linear_solver", "AMGSolver", "rigid_body_modes",
+__all__ = ["direct", "Factorization", "linear_solver", "AMGSolver", "rigid_body_modes",
            "pardiso_available", "DIRECT_LIMIT", "DIRECT_LIMIT_PARDISO",
            "DIRECT_NNZ_LIMIT_PARDISO",
            "auto_direct_limit", "submatrix", "newton", "NewtonControls",

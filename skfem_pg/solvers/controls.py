@@ -91,6 +91,15 @@ class NewtonControls(Controls):
         ``True``: a line per load step (on rank 0 of a distributed run);
         ``False``: silent; ``"auto"``: the lines from a few seconds into
         the run on (:mod:`skfem_pg.progress`).
+    reuse
+        Modified Newton (serial :func:`~skfem_pg.solvers.newton` with a
+        direct solve): keep the factorization of a tangent for later
+        iterations and load steps while each increment cuts the residual
+        by :data:`~skfem_pg.solvers.static.REUSE_CONTRACTION`, undo an
+        increment that raises it, and refactorize a fresh tangent
+        (:class:`~skfem_pg.solvers.static.KeptTangent`).  A step then
+        doubles the next one when it needed at most 2 fresh tangents
+        (the history's ``tangents``).
     """
 
     steps: int = 1
@@ -101,6 +110,7 @@ class NewtonControls(Controls):
     predictor: bool = True
     line_search: bool = False
     verbose: object = "auto"
+    reuse: bool = False
 
     def __post_init__(self):
         check_controls(steps=self.steps, tol=self.tol, maxiter=self.maxiter,

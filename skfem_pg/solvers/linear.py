@@ -155,7 +155,7 @@ def free_rigid_body_modes(A, doflocs, components=None, tol=RIGID_MODE_TOL):
     return free
 
 
-def direct(A, b, ordering="auto", **kwargs):
+def direct(A, b, ordering="auto", definite=None, **kwargs):
     """Sparse direct solve for FE and PG systems alike.
 
     ``ordering="auto"``: MKL PARDISO if ``pypardiso`` is installed
@@ -178,101 +178,184 @@ def direct(A, b, ordering="auto", **kwargs):
     Every answer is checked (:func:`check_solution`): a singular system
     raises :class:`~skfem_pg.errors.SingularSystemError` instead of
     returning a solution with a large residual or non-finite entries.
+    To solve many right-hand sides with one matrix keep its
+    :class:`Factorization`; ``definite=False`` skips PARDISO's Cholesky
+    attempt on a symmetric matrix known to be indefinite.
     """
-    A = A.tocsr()
-    b = np.asarray(b, dtype=float)
-    with warnings.catch_warnings():  # SuperLU's MatrixRankWarning: the
-        # check below turns a singular matrix into a named error
-        warnings.simplefilter("ignore", spl.MatrixRankWarning)
-        x = _direct(A, b, ordering)
-        if ordering in ("auto", "pardiso") and pardiso_available():
-            try:
-                return check_solution(A, b, x)
-            except SingularSystemError:  # PARDISO's perturbed pivots
-                # (a saddle point at nu = 0.5): SuperLU pivots for real
-                x = _direct(A, b, "rcm+mmd")
-    return check_solution(A, b, x)
-
-
-def _direct(A, b, ordering):
-    if ordering == "auto":
-        ordering = "pardiso" if pardiso_available() else "rcm+mmd"
-    if ordering == "pardiso":
-        return _pardiso(A, b)
-    if ordering == "rcm+mmd" and np.any(A.diagonal() == 0.0):
-        ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
-    if ordering == "colamd":
-        return spl.spsolve(A.tocsc(), b, permc_spec="COLAMD")
-    if ordering != "rcm+mmd":
-        raise ValueError("ordering must be 'auto', 'pardiso', 'rcm+mmd' or "
-                         "'colamd', got {!r}".format(ordering))
-    from scipy.sparse.csgraph import reverse_cuthill_mckee
-    p = reverse_cuthill_mckee(A, symmetric_mode=True)
-    Ap, bp = A[p][:, p].tocsc(), b[p]
-    x = np.empty_like(b)
-    # diagonal pivots first (symmetric: SuperLU's SymmetricMode; otherwise
-    # threshold pivoting that prefers the diagonal), checked by the residual
-    opts = (dict(diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-            if _symmetric(A) else dict(diag_pivot_thresh=DIAG_PIVOT))
+    f = Factorization(A, ordering, definite)
     try:
-        xp = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A", **opts).solve(bp)
-    except RuntimeError:  # a zero pivot: pivot partially
-        xp = np.full_like(bp, np.nan)
-    scale = np.abs(Ap).max() * max(np.abs(xp).max(), 1e-300)
-    if np.all(np.isfinite(xp)) and np.abs(Ap @ xp - bp).max() \
-            <= PIVOT_CHECK * max(scale, np.abs(bp).max()):
-        x[p] = xp
-        return x
-    x[p] = spl.spsolve(Ap, bp, permc_spec="MMD_AT_PLUS_A")
-    return x
+        return f.solve(b)
+    finally:
+        f.free()
 
 
-#: one ``pypardiso.PyPardisoSolver`` per matrix type, kept: creating one
-#: looks up MKL's library, which costs more than factorizing a small
-#: system; its factors are freed after every solve
+#: ``PyPardisoSolver`` instances per matrix type that hold no factors,
+#: kept: creating one looks up MKL's library, which costs more than
+#: factorizing a small system
 _PARDISO_SOLVERS = {}
 
 
-def _pardiso(A, b):
-    """MKL PARDISO: a symmetric matrix as real symmetric indefinite
-    (``mtype=-2``, LDL^T with Bunch–Kaufman pivoting, the upper triangle
-    only: half the fill of the LU mode, and PG's indefinite late Newton
-    tangents solve too), otherwise LU (``mtype=11``)."""
-    import pypardiso
-    full = A
-    mtype = -2 if _symmetric(A) else 11
-    if mtype == -2:
-        # the upper triangle with every diagonal entry stored (PARDISO's
-        # symmetric modes need them; a saddle point's are zero)
-        U = sp.triu(A, format="coo")
-        n = A.shape[0]
-        A = sp.csr_matrix((np.r_[U.data, np.zeros(n)],
-                           (np.r_[U.row, np.arange(n)],
-                            np.r_[U.col, np.arange(n)])), shape=A.shape)
-    solver = _PARDISO_SOLVERS.get(mtype)
-    if solver is None:
-        solver = _PARDISO_SOLVERS[mtype] = pypardiso.PyPardisoSolver(
-            mtype=mtype)
-    try:
-        x = solver.solve(A, b)
+class Factorization:
+    """A sparse direct factorization of ``A``, kept for many right-hand
+    sides (:func:`direct` is one of them; Newton's method keeps one for
+    several iterations, :class:`~skfem_pg.solvers.controls.NewtonControls`
+    ``reuse``).
+
+    ``ordering`` as in :func:`direct`.  :meth:`solve` checks every answer
+    (:func:`check_solution`); PARDISO's answers are refined with the same
+    factors, and a system PARDISO's perturbed pivots cannot solve (a
+    saddle point at nu = 0.5) is refactorized by SuperLU with real
+    pivoting.  :meth:`free` releases the factors (PARDISO's live outside
+    Python's memory).
+
+    >>> import scipy.sparse as sp
+    >>> f = Factorization(sp.diags([2.0, 4.0]).tocsr())
+    >>> f.solve([2.0, 2.0])
+    array([1. , 0.5])
+    >>> f.free()
+    """
+
+    def __init__(self, A, ordering="auto", definite=None):
+        self.A = A.tocsr()
+        self.definite = definite  # False: skip PARDISO's Cholesky
+        if ordering == "auto":
+            ordering = "pardiso" if pardiso_available() else "rcm+mmd"
+        if ordering not in ("pardiso", "rcm+mmd", "colamd"):
+            raise ValueError("ordering must be 'auto', 'pardiso', 'rcm+mmd' "
+                             "or 'colamd', got {!r}".format(ordering))
+        if ordering == "rcm+mmd" and np.any(self.A.diagonal() == 0.0):
+            ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
+        self.ordering = ordering
+        self._pardiso = self._superlu = None
+        self._checked = False  # SuperLU's diagonal pivots not yet checked
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spl.MatrixRankWarning)
+            self._factor(ordering)
+
+    def _factor(self, ordering, pivot=False):
+        A = self.A
+        if ordering == "pardiso":
+            import pypardiso
+            from pypardiso.pardiso_wrapper import PyPardisoError
+            symmetric = _symmetric(A)
+            self.factored = A
+            if symmetric:
+                # the upper triangle with every diagonal entry stored
+                # (PARDISO's symmetric modes need them; a saddle point's
+                # are zero)
+                U = sp.triu(A, format="coo")
+                n = A.shape[0]
+                self.factored = sp.csr_matrix(
+                    (np.r_[U.data, np.zeros(n)],
+                     (np.r_[U.row, np.arange(n)],
+                      np.r_[U.col, np.arange(n)])), shape=A.shape)
+            # a symmetric matrix: Cholesky (mtype 2) first, 15-20 % faster
+            # than LDL^T on 3-D tangents (benchmarks/README.md), which
+            # MKL refuses (error -4) for an indefinite matrix; then the
+            # symmetric indefinite LDL^T with Bunch-Kaufman pivots
+            for mtype in ((2, -2) if symmetric and self.definite is not
+                          False else (-2,) if symmetric else (11,)):
+                pool = _PARDISO_SOLVERS.setdefault(mtype, [])
+                self._pardiso = pool.pop() if pool else \
+                    pypardiso.PyPardisoSolver(mtype=mtype)
+                self.mtype = mtype
+                try:
+                    self._pardiso.factorize(self.factored)
+                except PyPardisoError:
+                    if mtype != 2:
+                        raise
+                    self.free()
+                    self.definite = False
+                    continue
+                self.definite = mtype == 2 or self.definite
+                return
+        if ordering == "colamd":
+            self.perm = None
+            self._superlu = spl.splu(A.tocsc(), permc_spec="COLAMD")
+            self._checked = True
+            return
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+        p = self.perm = reverse_cuthill_mckee(A, symmetric_mode=True)
+        Ap = A[p][:, p].tocsc()
+        # diagonal pivots first (symmetric: SuperLU's SymmetricMode;
+        # otherwise threshold pivoting that prefers the diagonal), checked
+        # by the residual of the first solve
+        opts = ({} if pivot else
+                dict(diag_pivot_thresh=0.0, options={"SymmetricMode": True})
+                if _symmetric(A) else dict(diag_pivot_thresh=DIAG_PIVOT))
+        self._checked = pivot
+        try:
+            self._superlu = spl.splu(Ap, permc_spec="MMD_AT_PLUS_A", **opts)
+        except RuntimeError:  # a zero pivot: pivot partially
+            if pivot:
+                raise SingularSystemError(
+                    "SuperLU found an exactly singular matrix ({} unknowns)"
+                    ": too few Dirichlet conditions, or a mechanism"
+                    .format(A.shape[0]))
+            self._factor(ordering, pivot=True)
+
+    def _solve_superlu(self, b):
+        p = self.perm
+        if p is None:
+            return self._superlu.solve(b)
+        x = np.empty_like(b)
+        x[p] = self._superlu.solve(b[p])
+        return x
+
+    def _solve_pardiso(self, b):
         # PARDISO perturbs tiny pivots (a nearly incompressible tangent):
-        # refine with the same factors (pypardiso keeps them for the same
-        # matrix) while the residual passes check_solution's first test
-        # or stops decreasing (a saddle point's can grow)
+        # refine with the same factors while the residual fails
+        # check_solution's first test and decreases (a saddle point's can
+        # grow)
+        solver, full = self._pardiso, self.A
+        x = solver.solve(self.factored, b)
         nb = np.abs(b).max() if b.size else 0.0
         r = b - full @ x
         for _ in range(PARDISO_REFINEMENTS):
             rn = np.abs(r).max()
             if not rn > RESIDUAL_CHECK * nb:
                 break
-            y = x + solver.solve(A, r)
+            y = x + solver.solve(self.factored, r)
             ry = b - full @ y
             if not np.abs(ry).max() < rn:
                 break
             x, r = y, ry
         return x
-    finally:
-        solver.free_memory(everything=True)
+
+    def solve(self, b):
+        """``A⁻¹ b`` by the kept factors, checked."""
+        b = np.asarray(b, dtype=float)
+        A = self.A
+        if self._pardiso is not None:
+            x = self._solve_pardiso(b)
+            try:
+                return check_solution(A, b, x)
+            except SingularSystemError:  # PARDISO's perturbed pivots (a
+                # saddle point at nu = 0.5): SuperLU pivots for real
+                self.free()
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", spl.MatrixRankWarning)
+                    self._factor("rcm+mmd")
+                self.ordering = "rcm+mmd"
+        x = self._solve_superlu(b)
+        if not self._checked:  # diagonal pivots: checked by the residual
+            scale = np.abs(A).max() * max(np.abs(x).max(), 1e-300)
+            if np.all(np.isfinite(x)) and np.abs(A @ x - b).max() \
+                    <= PIVOT_CHECK * max(scale, np.abs(b).max()):
+                self._checked = True
+            else:  # refactorize with partial pivoting
+                self._factor(self.ordering, pivot=True)
+                x = self._solve_superlu(b)
+        return check_solution(A, b, x)
+
+    def free(self):
+        """Release the factors (PARDISO's instance goes back to the
+        pool)."""
+        if self._pardiso is not None:
+            self._pardiso.free_memory(everything=True)
+            _PARDISO_SOLVERS.setdefault(self.mtype, []).append(self._pardiso)
+            self._pardiso = None
+        self._superlu = None
 
 
 #: iterative refinement steps after a PARDISO solve whose residual fails
@@ -527,6 +610,10 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
     modes when the free dofs are not whole nodes, e.g. with symmetry
     planes); Newton's method passes them.
 
+    ``solver.factorize(A)``: the kept :class:`Factorization` of ``A``
+    where the choice is a direct solve, else ``None`` (Newton's method
+    with ``reuse``).
+
     With ``doflocs``, every call first checks that the system resists
     each rigid-body mode (:func:`free_rigid_body_modes`) and raises
     :class:`~skfem_pg.errors.SingularSystemError` naming the free ones;
@@ -546,16 +633,36 @@ def linear_solver(kind="auto", doflocs=None, tol=1e-10, direct_limit=None,
                     direct_limit=4 * direct_limit, ordering=ordering,
                     candidates=candidates, components=components)
 
-    def solve(A, b, **kwargs):
+    def choice(A):
         if doflocs is not None and A.shape[0] == doflocs.shape[1]:
             require_stiffness(A, doflocs, components)
-        k = kind
-        if k == "auto":
-            small = A.shape[0] <= direct_limit and (
-                direct_nnz_limit is None or A.nnz <= direct_nnz_limit)
-            k = "direct" if small or doflocs is None else "amg"
-        if k == "direct":
-            return direct(A, b, ordering)
-        return amg(A, b)
+        if kind != "auto":
+            return kind
+        small = A.shape[0] <= direct_limit and (
+            direct_nnz_limit is None or A.nnz <= direct_nnz_limit)
+        return "direct" if small or doflocs is None else "amg"
+
+    seen = {}  # an indefinite matrix met: no more Cholesky attempts
+
+    def factorize(A):
+        """A kept :class:`Factorization` of ``A`` where this solver
+        solves ``A`` directly, else ``None`` (AMG keeps its hierarchy
+        instead)."""
+        if choice(A) != "direct":
+            return None
+        f = Factorization(A, ordering, seen.get("definite"))
+        if f.definite is False:
+            seen["definite"] = False
+        return f
+
+    def solve(A, b, **kwargs):
+        f = factorize(A)
+        if f is None:
+            return amg(A, b)
+        try:
+            return f.solve(b)
+        finally:
+            f.free()
     solve.amg = amg
+    solve.factorize = factorize
     return solve

@@ -125,7 +125,8 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     controls, **kw
         :class:`NewtonControls` (``steps``, ``tol``, ``maxiter``,
         ``min_step``, ``adaptive``, ``predictor``, ``line_search``,
-        ``verbose``), or its fields as keywords (they replace the record's).
+        ``verbose``, ``reuse``), or its fields as keywords (they replace
+        the record's).
 
     Returns
     -------
@@ -134,7 +135,29 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
         ``x[:model.n_u]``).  ``history`` is a list of dicts per converged
         step (load factor, residual norms per iteration, the increments'
         energies ``|Δx·r|``, minimum J, the criterion's note in
-        ``reason``, seconds).
+        ``reason``, seconds; with ``reuse``: ``tangents``, the fresh
+        tangents of the step, and ``undone``, the increments from kept
+        factors that were taken back).
+
+    Examples
+    --------
+    Modified Newton on a 2-D block (the factorization of a tangent kept
+    while it contracts the residual): the same answer as full Newton.
+
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem_pg.formulations import Hyperelastic
+    >>> from skfem_pg.materials import NeoHooke
+    >>> mesh = fem.MeshQuad.init_tensor(np.linspace(0, 4, 9),
+    ...                                  np.linspace(0, 1, 3))
+    >>> basis = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
+    >>> model = Hyperelastic(basis, NeoHooke(10.0, 4.0))
+    >>> D = basis.get_dofs(lambda x: x[0] == 0).all()
+    >>> f = np.zeros(basis.N)
+    >>> f[basis.get_dofs(lambda x: x[0] == 4).nodal["u^2"]] = -0.02
+    >>> u, hist = pg.solvers.newton(model, f, D=D, verbose=False)
+    >>> v, kept = pg.solvers.newton(model, f, D=D, verbose=False, reuse=True)
+    >>> bool(np.abs(u - v).max() < 1e-8 * np.abs(u).max())
+    True
 
     """
     opts = NewtonControls.of(controls, **kw)
@@ -173,16 +196,26 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
         if "prev_x" in saved:
             prev = (float(saved["prev_load"]), saved["prev_x"])
 
+    kept = KeptTangent() if opts.reuse else None
+
     def step(start, target):
         n_krylov = len(stats["iterations"])
+        n_tangents = 0 if kept is None else kept.stats["tangents"]
         out = newton_step(model, start, target, f_ext, Dd,
                           prescribed(target)[Dd], I, lin, opts.tol,
-                          opts.maxiter, opts.line_search)
+                          opts.maxiter, opts.line_search, kept)
         out[2]["krylov"] = stats["iterations"][n_krylov:]
+        if kept is not None:
+            out[2]["tangents"] = kept.stats["tangents"] - n_tangents
         return out
 
-    return load_stepping(model, step, SERIAL, u, lam, dlam, opts, prev=prev,
-                         callback=callback, every=Every.of(checkpoint))
+    try:
+        return load_stepping(model, step, SERIAL, u, lam, dlam, opts,
+                             prev=prev, callback=callback,
+                             every=Every.of(checkpoint))
+    finally:
+        if kept is not None:
+            kept.free()
 
 
 def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
@@ -233,7 +266,9 @@ def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
             prev = (lam, u)
             u, lam = uk, target
             history.append(info)
-            if options.adaptive and len(info["residuals"]) <= 5:
+            if options.adaptive and (
+                    info["tangents"] <= 2 if "tangents" in info
+                    else len(info["residuals"]) <= 5):
                 dlam = min(2 * dlam, 1.0)
             if every is not None:  # before the callback, which may fail
                 every.save(len(history), model, u, lam, step=dlam,
@@ -346,9 +381,17 @@ class SerialAlgebra:
     solver ``lin``.  The distributed counterpart is
     :class:`skfem_pg.distributed.solve.PetscAlgebra`."""
 
-    def __init__(self, model=None, f_ext=None, Dd=None, I=None, lin=None):
+    def __init__(self, model=None, f_ext=None, Dd=None, I=None, lin=None,
+                 kept=None):
         self.model, self.f_ext, self.Dd, self.I, self.lin = (
             model, f_ext, Dd, I, lin)
+        self.kept = kept  # a KeptTangent (modified Newton) or None
+        self.reused = False  # the last increment came from a kept factor
+
+    def expire(self):
+        """The next solve assembles and factorizes a fresh tangent."""
+        if self.kept is not None:
+            self.kept.fresh = True
 
     # vector arithmetic (load_stepping and the line search)
     @staticmethod
@@ -401,16 +444,29 @@ class SerialAlgebra:
         """The Newton increment (with the prescribed increment ``du_D``,
         or ``None``) and its energy :math:`|\\Delta x\\cdot r|`; returns
         ``(du, energy, t_assemble, t_linear)``."""
-        I, Dd = self.I, self.Dd
+        I, Dd, kept = self.I, self.Dd, self.kept
         t0 = time.perf_counter()
-        K = self.model.tangent(state).tocsr()
+        self.reused = kept is not None and kept.usable()
+        K = kept.K if self.reused else self.model.tangent(state).tocsr()
         t1 = time.perf_counter()
         du = np.zeros_like(u)
         rhs = -r[I]
         if du_D is not None:
             du[Dd] = du_D
             rhs = rhs - (K @ du)[I]
-        du[I] = self.lin(submatrix(K, I), rhs)
+        if self.reused:
+            kept.stats["reused"] += 1
+            du[I] = kept.solve(rhs)
+        else:
+            if kept is not None:
+                kept.stats["tangents"] += 1
+            KII = submatrix(K, I)
+            factor = None if kept is None else kept.factorize(self.lin, KII)
+            if factor is None:
+                du[I] = self.lin(KII, rhs)
+            else:
+                kept.keep(K, factor)
+                du[I] = kept.solve(rhs)
         return (du, abs(float(np.dot(du[I], rhs))), t1 - t0,
                 time.perf_counter() - t1)
 
@@ -426,13 +482,65 @@ SERIAL = SerialAlgebra()
 
 
 def newton_step(model, u, lam, f_ext, Dd, u_DD, I, lin, tol, maxiter,
-                line_search=False):
+                line_search=False, kept=None):
     """:func:`newton_iterations` on one process: ``f_ext`` the external
     force at load factor 1, ``Dd`` the prescribed dofs and ``u_DD`` their
     values at this load, ``I`` the free dofs, ``lin`` the condensed
-    solver."""
-    return newton_iterations(model, SerialAlgebra(model, f_ext, Dd, I, lin),
-                             u, lam, u_DD, tol, maxiter, line_search)
+    solver, ``kept`` a :class:`KeptTangent` (modified Newton) or
+    ``None``."""
+    return newton_iterations(
+        model, SerialAlgebra(model, f_ext, Dd, I, lin, kept), u, lam, u_DD,
+        tol, maxiter, line_search)
+
+
+#: modified Newton (``NewtonControls.reuse``): an increment from a kept
+#: factorization is accepted where it cuts the residual norm at least by
+#: this factor; one that does not (or fails: J <= 0, a return map) is
+#: undone and the next increment assembles and factorizes a fresh
+#: tangent, as does the one after a fresh increment that contracted less.
+#: Accepting slower increments that still decreased the residual cost 2-6x
+#: on the 3-D Cook (Newton led astray to J <= 0 and cut steps); 0.1, 0.25
+#: and 0.5 were within 10 % of each other (benchmarks/README.md,
+#: ``factor_reuse``)
+REUSE_CONTRACTION = 0.25
+
+
+class KeptTangent:
+    """Modified Newton's kept tangent ``K`` and the factorization of its
+    free block, shared by the iterations and load steps of one
+    :func:`newton` call (``NewtonControls.reuse``): each increment solves
+    with the kept factors until one of them contracts the residual by
+    less than :data:`REUSE_CONTRACTION`; then the next increment takes a
+    fresh tangent.  ``stats``: fresh tangents (each factorized, unless the
+    linear solver has no kept factorization: AMG, a user's callable) and
+    increments solved with kept factors."""
+
+    def __init__(self):
+        self.K = self.factor = None
+        self.fresh = True
+        self.stats = {"tangents": 0, "reused": 0}
+
+    def usable(self):
+        return self.factor is not None and not self.fresh
+
+    @staticmethod
+    def factorize(lin, A):
+        """The linear solver's kept factorization of ``A``, or ``None``
+        where it has none (a user's callable, AMG)."""
+        factorize = getattr(lin, "factorize", None)
+        return None if factorize is None else factorize(A)
+
+    def keep(self, K, factor):
+        self.free()
+        self.K, self.factor, self.fresh = K, factor, False
+
+    def solve(self, b):
+        return self.factor.solve(b)
+
+    def free(self):
+        if self.factor is not None:
+            self.factor.free()
+        self.K = self.factor = None
 
 
 def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
@@ -466,10 +574,12 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
     energy = []  # |du · rhs| of each solve
     info = {"residuals": res, "energies": energy, "min_J": np.nan,
             "reason": "", "t_assemble": 0.0, "t_linear": 0.0,
-            "backtracks": 0}
+            "backtracks": 0, "undone": 0}
     ref = None
     small = False
     back = None  # (iterate, increment, length) while it may be halved
+    undo = None  # the iterate before an increment from kept factors
+    fresh = False  # the last increment came from a fresh kept tangent
     it = 0
     while True:
         t0 = time.perf_counter()
@@ -487,6 +597,23 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
             if not np.isfinite(rn):
                 fail = "non-finite residual"
         info["t_assemble"] += time.perf_counter() - t0
+        redo = False
+        if undo is not None:  # the increment came from kept factors
+            if fail is not None or not rn <= REUSE_CONTRACTION * res[-1]:
+                # too slow (a slow increment can lead Newton astray) or
+                # failed: undo it, and solve again at the iterate before
+                # with a fresh tangent
+                u, state, r, rn, f_int, pending = undo
+                energy.pop()
+                fail, small, redo = None, False, True
+                info["undone"] += 1
+                algebra.expire()
+            undo = None
+        elif fresh and not rn <= REUSE_CONTRACTION * res[-1]:
+            # Newton is not yet contracting fast even with a fresh
+            # tangent: the next increment takes a fresh one too
+            algebra.expire()
+        fresh = False
         if back is not None and back[2] > 0.5 ** LINE_SEARCH_HALVINGS \
                 and (fail is not None or (len(res) >= 2 and rn > res[-1])):
             u0, du0, s = back
@@ -499,8 +626,9 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
             return False, u, info, None
         back = None
         info["f_int"] = f_int
-        res.append(rn)
-        if not pending:
+        if not redo:
+            res.append(rn)
+        if not pending and not redo:
             if ref is None:
                 ref = max(algebra.load_norm(lam), rn, 1e-300)
             done, info["reason"] = verdict(res, energy, ref, tol, small)
@@ -518,9 +646,13 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
         energy.append(e)
         info["t_assemble"] += t_asm
         info["t_linear"] += t_lin
-        if line_search and not pending and \
-                energy[-1] > ROUNDOFF_ENERGY * tol * energy[0]:
-            back = (algebra.copy(u), du, 1.0)
+        if getattr(algebra, "reused", False):  # undone if it fails
+            undo = (algebra.copy(u), state, r, rn, f_int, pending)
+        else:
+            fresh = getattr(algebra, "kept", None) is not None
+            if line_search and not pending and \
+                    energy[-1] > ROUNDOFF_ENERGY * tol * energy[0]:
+                back = (algebra.copy(u), du, 1.0)
         u = algebra.impose(algebra.add(u, du), prescribed)
         small = algebra.small_increment(du, u)
         pending = False
