@@ -3,6 +3,7 @@ series of them (``.pvd`` collections)."""
 from __future__ import annotations
 
 import os
+import tempfile
 
 import numpy as np
 import meshio
@@ -129,6 +130,15 @@ class VTUSeries:
         if suffix not in ("vtu", "pvtu"):
             raise ValueError("a VTU series holds .vtu or .pvtu files, got "
                              "suffix={!r}".format(suffix))
+        name = os.path.basename(os.path.normpath(os.fspath(folder))) \
+            if isinstance(folder, (str, os.PathLike)) else None
+        if not name or name in (".", "..", os.sep):
+            raise ValueError(
+                "VTUSeries needs a folder with a name for its steps, got "
+                "{!r}: the collection is written beside it as NAME.pvd "
+                "(e.g. VTUSeries('out/run') writes out/run/step_000.vtu and "
+                "out/run.pvd)".format(folder))
+        folder = os.fspath(folder)
         self.folder, self.entries = folder, []
         self.suffix, self.collection = suffix, collection
         os.makedirs(folder, exist_ok=True)
@@ -141,11 +151,20 @@ class VTUSeries:
         if not self.collection:
             return fn
         sub = os.path.basename(os.path.normpath(self.folder))
-        with open(os.path.normpath(self.folder) + ".pvd", "w") as f:
-            f.write('<?xml version="1.0"?>\n<VTKFile type="Collection">\n'
-                    '<Collection>\n')
-            for time, name in self.entries:
-                f.write('<DataSet timestep="{:.9g}" file="{}/{}"/>\n'.format(
-                    time, sub, name))
-            f.write('</Collection>\n</VTKFile>\n')
+        text = ['<?xml version="1.0"?>\n<VTKFile type="Collection">\n'
+                '<Collection>\n']
+        text += ['<DataSet timestep="{:.9g}" file="{}/{}"/>\n'.format(
+            time, sub, name) for time, name in self.entries]
+        text.append('</Collection>\n</VTKFile>\n')
+        # atomically: a kill during the write keeps the previous collection
+        path = os.path.normpath(self.folder) + ".pvd"
+        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)),
+                                   prefix=".pvd-", suffix=".tmp")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write("".join(text))
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
         return fn

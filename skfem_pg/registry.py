@@ -21,7 +21,12 @@ field                     used by
                           or ``"stabilized"``
 ``master_only``           the gradient lives at the master alone: no bond
                           correction (U1SIG)
-``updated_lagrangian``    the UL frame is built for it
+``updated_lagrangian``    the UL frame is built for it: ``True`` for the
+                          package's displacement formulation (the scene
+                          builds :class:`~skfem_pg.formulations.
+                          UpdatedLagrange`), or a callable
+                          ``build_ul(basis, material, every)`` that builds
+                          the formulation's own UL model
 ``distributed``           the distributed Newton solves it
                           (``Scene.solve(..., comm=...)``)
 ========================  =====================================================
@@ -37,6 +42,7 @@ scalar element, its Gauss rule and whether it is the mean-dilatation
 (P0) variant; :class:`~skfem_pg.scenes.Scene`, the name parser and
 ``model_for`` read them.
 """
+import inspect
 import re
 from dataclasses import dataclass
 from typing import Callable
@@ -59,6 +65,7 @@ class Formulation:
     master_only: bool = False
     updated_lagrangian: bool = False
     distributed: bool = False
+    build_ul: Callable = None
 
     @property
     def first_order(self):
@@ -71,14 +78,21 @@ _FORMULATIONS = {}
 def register(token, shape, build, kind="displacement", master_only=False,
              updated_lagrangian=False, distributed=False, replace=False):
     """Register the formulation ``token`` (see the module docstring);
-    ``ValueError`` naming what does not fit (a token with blanks, an
-    unknown shape or kind, a ``build`` that is not callable, a token
-    already registered unless ``replace``).  Returns the record."""
+    ``ValueError`` naming what does not fit (a token with blanks, a name
+    keyword or an FE comparator's name, an unknown shape or kind, a
+    ``build`` that is not callable with ``(basis, material, tangent)``,
+    ``updated_lagrangian=True`` for a formulation the package's UL model
+    does not build, a token already registered unless ``replace``).
+    Returns the record."""
     if not isinstance(token, str) or not re.fullmatch(r"[^\s]+", token) \
             or token in ("TL", "UL", "noBC", "kNN", "meshU", "MQ",
                              "FEM"):
         raise ValueError("a formulation token is one word and not a name "
                          "keyword, got {!r}".format(token))
+    if token in _FE:
+        raise ValueError("{!r} is the name of an FE comparator (a scene "
+                         "solves the FE method under it, never this "
+                         "formulation): choose another token".format(token))
     if shape not in SHAPE_FUNCTIONS:
         raise ValueError("formulation {!r}: shape must be one of {}, got "
                          "{!r}".format(token, ", ".join(SHAPE_FUNCTIONS),
@@ -86,16 +100,47 @@ def register(token, shape, build, kind="displacement", master_only=False,
     if kind not in KINDS:
         raise ValueError("formulation {!r}: kind must be one of {}, got "
                          "{!r}".format(token, ", ".join(KINDS), kind))
-    if not callable(build):
-        raise ValueError("formulation {!r}: build must be callable "
-                         "(basis, material, tangent) -> model".format(token))
+    if not callable(build) or not _accepts(build, 3):
+        raise ValueError("formulation {!r}: build must be callable as "
+                         "build(basis, material, tangent) -> model, got {!r}"
+                         .format(token, build))
+    build_ul = None
+    if callable(updated_lagrangian) and not isinstance(updated_lagrangian,
+                                                       bool):
+        if not _accepts(updated_lagrangian, 3):
+            raise ValueError(
+                "formulation {!r}: updated_lagrangian must be True or "
+                "callable as build_ul(basis, material, every) -> model"
+                .format(token))
+        build_ul = updated_lagrangian
+    elif updated_lagrangian and not getattr(build, "updated_lagrangian",
+                                            False):
+        raise ValueError(
+            "formulation {!r}: updated_lagrangian=True builds the "
+            "package's UpdatedLagrange model (the displacement "
+            "formulation), not {!r}: pass updated_lagrangian=build_ul, a "
+            "callable (basis, material, every) -> your model in the UL "
+            "frame".format(token, build))
     if token in _FORMULATIONS and not replace:
         raise ValueError("formulation {!r} is registered already (pass "
                          "replace=True to replace it)".format(token))
     record = Formulation(token, shape, build, kind, bool(master_only),
-                         bool(updated_lagrangian), bool(distributed))
+                         bool(updated_lagrangian), bool(distributed),
+                         build_ul)
     _FORMULATIONS[token] = record
     return record
+
+
+def _accepts(f, n):
+    """Whether ``f`` can be called with ``n`` positional arguments (a
+    callable without a signature passes)."""
+    try:
+        inspect.signature(f).bind(*([None] * n))
+    except TypeError:
+        return False
+    except ValueError:  # no signature (a builtin)
+        return True
+    return True
 
 
 def unregister(token):

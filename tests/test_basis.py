@@ -139,3 +139,72 @@ def test_amg_vc_solve_equals_the_lu(dim, monkeypatch):
     monkeypatch.setattr(corrections, "AMG_VC_LIMIT_3D", 10)
     auto = pg.FamilyBasis(p, dim=dim)
     assert auto.vc_report.solver == ("amg" if dim == 3 else "direct")
+
+
+def test_scikit_fem_arguments_and_bad_options_are_named():
+    """Issue 47: the literal swap FamilyBasis(mesh, element) died in an
+    AttributeError, intorder= in a bare TypeError, a spec of dim=2 built a
+    2-component basis on 3-D particles, NaN area vectors were reported as
+    a singular moment matrix and vc_tolerance=-1 as a failed patch test."""
+    import skfem as fem
+    from skfem_pg.discretization.builder import BasisSpec
+    mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    with pytest.raises(TypeError, match=r"ElementTriP1\(\)\): a FamilyBasis "
+                                        r"takes no element.*dim=mesh.dim"):
+        pg.FamilyBasis(mesh, fem.ElementTriP1())
+    with pytest.raises(TypeError, match="intorder=4: a FamilyBasis "
+                                        "integrates at its family members"):
+        pg.FamilyBasis(mesh, intorder=4)
+    with pytest.raises(TypeError, match="unexpected keyword.*'colour'"):
+        pg.FamilyBasis(mesh, colour="red")
+    p2 = pg.Particles.from_mesh(mesh)
+    spec = BasisSpec.resolve(p2, dim=2)
+    cube = pg.Particles.from_mesh(fem.MeshTet.init_tensor(
+        *(np.linspace(0, 1, 3),) * 3))
+    with pytest.raises(ValueError, match="resolved for dim=2 .* 3-D"):
+        pg.FamilyBasis.from_spec(cube, spec)
+    A = p2.area_vectors().copy()
+    A[0, 3] = np.nan
+    with pytest.raises(ValueError, match="area_vectors of 1 particles are "
+                                         "not finite .*particle 3"):
+        pg.FamilyBasis(p2, dim=2, area_vectors=A)
+    for tol in (-1.0, 0.0, np.nan, "1e-8"):
+        with pytest.raises(ValueError, match="vc_tolerance must be"):
+            pg.FamilyBasis(mesh, dim=2, vc_tolerance=tol)
+
+
+def test_element_dofs_columns_are_families_not_cells():
+    """Issue 47 (scikit-fem's ex26): selecting element_dofs' columns by
+    cell numbers picked families of other particles and the answer was
+    exactly 0.0; it raises now and names the particles' dofs.  Rows,
+    slices, single columns and the whole array work as on a Basis."""
+    import skfem as fem
+    mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    b = pg.FamilyBasis(mesh, dim=2)
+    e = b.element_dofs
+    with pytest.raises(IndexError, match="families .* not mesh cells.*"
+                                         "nodal_dofs"):
+        e[:, np.array([0, 3])]
+    assert type(e[0]) is np.ndarray and e[:, 3].shape == (e.shape[0],)
+    assert type(e.T) is np.ndarray and e.T[:, np.array([0, 1])].shape \
+        == (e.shape[1], 2)
+    assert np.array_equal(np.asarray(e)[:, [0, 3]][:, 1], e[:, 3])
+
+
+def test_point_source_interpolator_and_project_speak_scikit_fem():
+    """Issue 47 (scikit-fem's ex38): point_source was missing and project
+    said "must return shape (1, n), got (2, n)" without saying that x is
+    (dim, n) on a family basis.  point_source and interpolator equal
+    scikit-fem's P1 ones on the collocation mesh."""
+    import skfem as fem
+    mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    b, p1 = pg.FamilyBasis(mesh), fem.Basis(mesh, fem.ElementTriP1())
+    x = np.array([0.3, 0.2])
+    assert np.abs(b.point_source(x) - p1.point_source(x)).max() <= 1e-15
+    u = mesh.p[0] ** 2 + 2 * mesh.p[1]
+    pts = np.array([[0.3, 0.55], [0.2, 0.9]])
+    assert np.allclose(b.interpolator(u)(pts), p1.interpolator(u)(pts))
+    with pytest.raises(ValueError, match=r"positions x of shape \(dim, n\)"):
+        b.project(lambda x: np.vstack([x[0], x[1]]))
+    with pytest.raises(ValueError, match="vector basis"):
+        pg.FamilyBasis(mesh, dim=2).point_source(x)

@@ -139,3 +139,79 @@ def test_a_dynamic_run_resumes_to_round_off(tmp_path, integrator):
     e_full, e = full.series("relative_error"), resumed.series(
         "relative_error")
     assert len(e) == len(e_full) and np.abs(e - e_full).max() <= 1e-12
+
+
+def test_a_checkpoint_knows_its_driver_and_what_it_holds(tmp_path):
+    """Issue 47: a checkpoint carries the kind of run that wrote it — an
+    explicit run's is refused by newton (it was read as load factor t and
+    returned after 0 steps), a static one by the integrators (a bare
+    KeyError) — and save checks what it writes (a load factor of 1.5 or
+    NaN, the wrong length); a plain .npz and an older format are named
+    as such."""
+    basis, D, v0 = _bar()
+    material = NeoHookeIsoVol(40.0, 80.0)
+    m = lumped_mass(basis, 1.0)
+    model = model_for("Unl", basis, material)
+    ck = checkpoint.Every(tmp_path / "dyn", steps=5)
+    central_difference(model, m, 0.3, D=D, v0=v0, verbose=False,
+                       checkpoint=ck)
+    with pytest.raises(ValueError, match="explicit run .*newton.* cannot "
+                                         "resume"):
+        newton(model_for("Unl", basis, material), D=D, resume=ck.path)
+    with pytest.raises(ValueError, match="explicit run .*Newmark run "
+                                         "cannot"):
+        newmark(model_for("Unl", basis, material), m, 0.6, 0.02, D=D,
+                verbose=False, resume=ck.path)
+    static = checkpoint.save(tmp_path / "s", model, np.zeros(basis.N), 0.5,
+                             kind="static")
+    with pytest.raises(ValueError, match="static run .*explicit run"):
+        central_difference(model_for("Unl", basis, material), m, 0.6, D=D,
+                           verbose=False, resume=static)
+    # a checkpoint of no driver lacks the integrator's state: named
+    bare = checkpoint.save(tmp_path / "b", model, np.zeros(basis.N), 0.1)
+    with pytest.raises(ValueError, match=r"lacks the state .*\(v, a, "):
+        central_difference(model_for("Unl", basis, material), m, 0.6, D=D,
+                           verbose=False, resume=bare)
+    # save checks what it writes
+    for load, kind in ((1.5, "static"), (np.nan, None), (-1.0, "explicit")):
+        with pytest.raises(ValueError, match="load = "):
+            checkpoint.save(tmp_path / "x", model, np.zeros(basis.N), load,
+                            kind=kind)
+    with pytest.raises(ValueError, match="shape .* unknowns"):
+        checkpoint.save(tmp_path / "x", model, np.zeros(basis.N + 2), 0.5)
+    with pytest.raises(ValueError, match="non-finite"):
+        checkpoint.save(tmp_path / "x", model, np.full(basis.N, np.inf))
+    with pytest.raises(ValueError, match="kind must be"):
+        checkpoint.save(tmp_path / "x", model, np.zeros(basis.N), kind="ul")
+    # a load factor outside [0, 1] in a checkpoint of no driver: newton
+    # refuses it instead of returning the stored x after 0 steps
+    odd = checkpoint.save(tmp_path / "o", model, np.zeros(basis.N), 1.5)
+    with pytest.raises(ValueError, match=r"load factor 1.5.*\[0, 1\]"):
+        newton(model_for("Unl", basis, material), D=D, resume=odd)
+    np.savez(tmp_path / "results.npz", u=np.zeros(basis.N))
+    with pytest.raises(ValueError, match="not a skfem-pg checkpoint .*u"):
+        checkpoint.load(tmp_path / "results", model)
+    with np.load(static) as f:
+        old = {k: f[k] for k in f.files}
+    old["format"] = 2
+    np.savez(tmp_path / "old.npz", **old)
+    with pytest.raises(ValueError, match="format 2 .*earlier"):
+        checkpoint.load(tmp_path / "old", model)
+
+
+def test_a_checkpoint_of_another_triangulation_is_refused(tmp_path):
+    """Issue 47: the same vertices triangulated otherwise (same counts)
+    differ in the fingerprint's cells — a crack mask or a history would
+    land on other cells."""
+    quads = fem.MeshQuad.init_tensor(np.linspace(0, 1, 4),
+                                     np.linspace(0, 1, 4))
+    q = quads.t
+    a = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]]))
+    b = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 3]], q[[1, 2, 3]]]))
+    material = NeoHookeIsoVol(40.0, 80.0)
+    ma = model_for("Unl", pg.FamilyBasis(a, dim=2), material)
+    mb = model_for("Unl", pg.FamilyBasis(b, dim=2), material)
+    path = checkpoint.save(tmp_path / "a", ma, np.zeros(ma.N), 0.5)
+    with pytest.raises(ValueError, match="cells"):
+        checkpoint.load(path, mb)
+    assert checkpoint.load(path, ma)[1] == 0.5

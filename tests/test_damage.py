@@ -331,3 +331,22 @@ def test_mean_dilatation_carries_damage_as_the_displacement_law(element):
                        (np.diag([0.95, 0.95]), True)):
         P = mixed.stress(mixed.state(affine(F)))
         assert (np.abs(P).max() > 1.0) == carries
+
+
+def test_johnson_cook_failure_strain_is_never_nan_or_everywhere_zero():
+    """Issue 47: D2 = 0 with a steep D3 gave 0 * inf = NaN failure strains
+    in compression (the points failed at their first plastic step); D1 <=
+    0 with D2 = 0 failed every yielding point at once.  A steep D3 with
+    D2 > 0 saturates (no failure in deep compression)."""
+    from skfem_pg.materials import JohnsonCookDamage
+    t = np.array([-5.0, -1.0, 0.0, 1.0 / 3.0, 2.0])
+    flat = JohnsonCookDamage(0.3, 0.0, -300.0, 1.0)
+    assert np.array_equal(flat.failure_strain(t), np.full(5, 0.3))
+    assert np.all(np.isfinite(flat.increment(np.full(5, 0.01), t)))
+    steep = JohnsonCookDamage(0.05, 3.44, -300.0, 1.0)
+    ef = steep.failure_strain(t)
+    assert not np.any(np.isnan(ef)) and ef[0] == np.inf
+    assert steep.increment(np.full(5, 0.01), t)[0] == 0.0
+    with pytest.raises(ValueError, match="D2 = 0 .* D1 <= 0"):
+        JohnsonCookDamage(-0.1, 0.0, -2.0, 1.0)
+    JohnsonCookDamage(-0.09, 0.27, 0.48, 1.0)  # D1 < 0 with D2 > 0 fits

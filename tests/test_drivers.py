@@ -56,6 +56,27 @@ def test_controls_are_checked_by_name():
         ExplicitControls(estimate_every=2.5)
 
 
+def test_controls_that_ran_into_a_wrong_reason_are_refused():
+    """Issue 47: a safety factor above 1 ran unstable and stopped as an
+    "inverted point", beta = inf as "J <= 0", 10 million load steps as
+    "diverging" (below min_step), gamma = 0.3 returned a trajectory with a
+    49 % energy error."""
+    with pytest.raises(ValueError, match=r"safety must be a factor in "
+                                         r"\(0, 1\]"):
+        ExplicitControls(safety=3.0)
+    ExplicitControls(safety=1.0)
+    with pytest.raises(ValueError, match="beta and gamma must be positive "
+                                         "numbers"):
+        NewmarkControls(beta=np.inf)
+    with pytest.raises(ValueError, match="gamma = 0.3 < 1/2"):
+        NewmarkControls(gamma=0.3)
+    NewmarkControls(beta=1.0 / 6.0, gamma=0.5)  # linear acceleration
+    with pytest.raises(ValueError, match="below min_step"):
+        NewtonControls(steps=10_000_000)
+    NewtonControls(steps=10_000_000, min_step=1e-8)
+    NewtonControls(steps=10_000_000, adaptive=False)
+
+
 def test_the_linear_algebra_is_injected(beam):
     """load_stepping + newton_iterations with a wrapped SerialAlgebra (what
     the distributed Newton does with PETSc's): the same answer as newton,

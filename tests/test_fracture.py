@@ -254,6 +254,28 @@ def test_bond_model_refuses_what_it_cannot_do():
             BondBased(basis, **kw)
 
 
+def test_bond_model_refuses_horizons_and_particles_without_meaning():
+    """Issue 47: an infinite horizon or one larger than the body (zero or
+    3e-6 stiffness) was accepted; particles outside the elements they
+    were collocated from made the spacing 0 and the message "horizon must
+    be positive, got 3.0"."""
+    basis = square(8)
+    for kw in (dict(horizon=np.inf), dict(horizon=100.0, absolute=True),
+               dict(horizon=np.nan)):
+        with pytest.raises(ValueError, match="horizon"):
+            BondBased(basis, 1.0, **kw)
+    with pytest.raises(ValueError, match="spans the whole body"):
+        BondBased(basis, 1.0, horizon=100.0, absolute=True)
+    BondBased(basis, 1.0, horizon=0.3, absolute=True)
+    mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 9),) * 2)
+    part = pg.FamilyBasis(pg.Particles.from_mesh(mesh,
+                                                 elements=np.arange(20)),
+                          dim=2)
+    with pytest.raises(ValueError, match="particles have no volume "
+                                         r".*\(mesh.restrict"):
+        BondBased(part, 1.0)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("element", ["Q1", "Q1P0"])
 def test_fe_with_the_same_damage_erodes_across_the_strip(element):

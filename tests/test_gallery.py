@@ -212,8 +212,11 @@ def test_two_materials_evaluated_per_bond():
     interface value moves by 5 % with the choice (+5.4 % left, +0.4 %
     right at 33² nodes), the left probe by 7 %.  The per-bond evaluation
     (``coefficients.cell_values_at_members``: the cell at each bond's
-    midpoint, the cells' mean at the master) lets an interface family see
-    both sides: −0.06 / +0.57 / +1.37 % (Q1 +0.09 / 0.08 / 0.07 %).  A
+    midpoint, their mean for a bond along the interface, the cells' mean
+    at the master) lets an interface family see both sides: −1.29 /
+    −0.04 / +1.33 % (until issue 47, scikit-fem's finder put the bonds
+    along the interface on one side: −0.06 / +0.57 / +1.37 %; Q1 +0.09 /
+    0.08 / 0.07 %).  A
     value per cell handed to a PG form is refused with that pointer."""
     from skfem_pg.discretization.coefficients import cell_values_at_members
     mesh, k_cells = two_materials(32)
@@ -260,3 +263,45 @@ def test_an_equal_order_pg_pressure_pair_is_flagged():
     with warnings.catch_warnings():
         warnings.simplefilter("error", pg.MixedBasisWarning)
         coupling.assemble(fe_u, fe_u.with_element(fem.ElementQuad0()))
+
+
+def test_cell_values_find_every_bond_midpoint_vectorized():
+    """Issue 47 (scikit-fem's ex17): bond midpoints on a curved mesh's
+    boundary chords died with scikit-fem's "Point is outside of the
+    mesh".  ``locate`` finds the cell of every point, vectorized: the
+    same cells as scikit-fem's finder inside distorted quads, hexahedra
+    and tetrahedra (a regular hex grid: planar faces); a point on the
+    boundary gets a boundary cell, a point outside the mesh its closest
+    cell; a bond along the material interface the mean of both sides."""
+    from skfem_pg.discretization.coefficients import (
+        cell_values_at_members, locate)
+    circle = fem.MeshTri.init_circle(4)
+    b = pg.FamilyBasis(circle)
+    k = np.where(np.hypot(*circle.p[:, circle.t].mean(axis=1)) < 0.5,
+                 10.0, 1.0)  # a wire in insulation
+    v = cell_values_at_members(b, k)
+    mem, mask = b.families.padded()
+    bonds = v[:, 1:][mask[:, 1:]]  # masters: volume-weighted means
+    assert set(np.unique(bonds)) == {1.0, 5.5, 10.0}  # 5.5: along the
+    # interface, a bond half on either side
+    # a family on the interface sees both sides
+    both = [(row[m[1:]] == 1.0).any() and (row[m[1:]] == 10.0).any()
+            for row, m in zip(v[:, 1:], mask)]
+    assert any(both)
+    rng = np.random.default_rng(4)
+    for mesh in (pg.meshing.distort(fem.MeshQuad.init_tensor(
+            *(np.linspace(0, 1, 7),) * 2), 0.3, seed=2),
+                 fem.MeshTet.init_tensor(*(np.linspace(0, 1, 4),) * 3),
+                 fem.MeshHex.init_tensor(*(np.linspace(0, 1, 4),) * 3)):
+        x = rng.uniform(0.02, 0.98, size=(mesh.dim(), 300))
+        ref = mesh.element_finder()(*x)
+        assert np.array_equal(locate(mesh, x), ref)
+    # on the boundary and outside: the nearest cell
+    sq = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    c = locate(sq, np.array([[1.0, 1.5, -0.2], [0.6, 0.5, 0.1]]))
+    cen = sq.p[:, sq.t].mean(axis=1)
+    assert np.all(cen[0, c[:2]] > 0.75) and cen[0, c[2]] < 0.25
+    import doctest
+    from skfem_pg.discretization import coefficients
+    result = doctest.testmod(coefficients)
+    assert result.attempted > 0 and result.failed == 0

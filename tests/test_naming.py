@@ -198,10 +198,7 @@ def test_a_formulation_of_ones_own_is_one_registration():
                             lambda basis, material, tangent:
                             Doubled(basis, material, tangent=tangent))
     try:
-        mesh = fem.MeshQuad.init_tensor(
-            np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
-            {"left": lambda x: np.isclose(x[0], 0),
-             "right": lambda x: np.isclose(x[0], 4)})
+        mesh = _strip()
 
         def scene(t):
             return Scene("own", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
@@ -256,10 +253,7 @@ def test_an_fe_comparator_of_ones_own_is_one_registration():
     pg.registry.register_fe("Q1G3", fem.MeshQuad1, fem.ElementQuad1,
                             intorder=4)
     try:
-        mesh = fem.MeshQuad.init_tensor(
-            np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
-            {"left": lambda x: np.isclose(x[0], 0),
-             "right": lambda x: np.isclose(x[0], 4)})
+        mesh = _strip()
         sc = Scene("own-fe", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
                    tractions={"right": [0.0, 0.1]},
                    probes={"tip": (4.0, 1.0)})
@@ -271,3 +265,55 @@ def test_an_fe_comparator_of_ones_own_is_one_registration():
         pg.registry.unregister_fe("Q1G3")
     with pytest.raises(ValueError, match="unknown FE comparator"):
         fe_method("FEM Q1G3")
+
+
+def test_the_registry_routes_every_frame_and_reserves_fe_names():
+    """Issue 47: an FE comparator's name is not a formulation token (the
+    FE method won and the builder was never called); a user's formulation
+    claiming the UL frame is refused unless it builds its own UL model,
+    which the scene then calls (the scene built the package's UL
+    displacement model: 44 % off, no word); a builder of the wrong
+    signature is refused where it is registered, not in a bare TypeError
+    at the solve."""
+    import numpy as np
+    import skfem as fem
+    from skfem_pg.formulations import Hyperelastic, UpdatedLagrange
+    from skfem_pg.materials import NeoHooke
+    from skfem_pg.scenes import Scene
+
+    def build(basis, material, tangent):
+        return Hyperelastic(basis, material, tangent=tangent)
+    with pytest.raises(ValueError, match="'Q1' is the name of an FE"):
+        pg.register_formulation("Q1", "MTE1", build)
+    with pytest.raises(ValueError, match="build must be callable as"):
+        pg.register_formulation("Two", "MTE1", lambda basis, material: 0)
+    with pytest.raises(ValueError, match="updated_lagrangian=build_ul"):
+        pg.register_formulation("MyUL", "MTE1", build,
+                                updated_lagrangian=True)
+    built = []
+
+    def build_ul(basis, material, every):
+        built.append(every)
+        return UpdatedLagrange(basis, material, every=every)
+    pg.register_formulation("MyUL", "MTE1", build,
+                            updated_lagrangian=build_ul)
+    try:
+        mesh = _strip()
+        sc = Scene("own", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+                   tractions={"right": [0.0, 0.1]}, steps=2)
+        basis, model, *_ = sc.setup("VCPBG V5m MyUL UL")
+        assert built == [1] and isinstance(model, UpdatedLagrange)
+        basis, model, *_ = sc.setup("VCPBG V5m MyUL")
+        assert built == [1] and type(model) is Hyperelastic
+    finally:
+        pg.registry.unregister("MyUL")
+
+
+def _strip():
+    """A 4 x 1 strip of 8 x 2 quadrilaterals, its ends named."""
+    import numpy as np
+    import skfem as fem
+    return fem.MeshQuad.init_tensor(
+        np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
+        {"left": lambda x: np.isclose(x[0], 0),
+         "right": lambda x: np.isclose(x[0], 4)})

@@ -1,3 +1,5 @@
+import os
+
 import numpy as np
 import pytest
 import skfem as fem
@@ -75,6 +77,11 @@ def test_vtu_series_lists_its_steps(tmp_path):
                                       for k in range(3)]
     last = meshio.read(str(tmp_path / listed[-1][1]))
     assert np.all(last.point_data["a"] == 1.0)
+    # issue 47: a folder without a name (a bare FileNotFoundError: '')
+    for folder in ("", ".", "/"):
+        with pytest.raises(ValueError, match="folder with a name"):
+            VTUSeries(folder)
+    assert not [f for f in os.listdir(tmp_path) if f.startswith(".pvd-")]
 
 
 def test_small_strain_law_reports_its_own_stress():

@@ -146,3 +146,89 @@ def test_check_sliding_names_the_particle():
         check_sliding(sn, 2 * bottom + 1)
     check_sliding(sn, np.concatenate([2 * bottom, 2 * bottom + 1]))
     check_sliding(pg.FamilyBasis(mesh, dim=2), 2 * bottom + 1)
+
+
+def test_cache_keys_see_every_parameter_to_the_last_bit():
+    """Issue 47: every parameter of every nested law enters the overkill
+    cache key by its exact value — one ulp of the hardening's A, of the
+    damage's D1, of sigma_y0, of a solve keyword gives another key (a
+    6-digit repr shared one file between A = 792 and 792.00008)."""
+    from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
+                                    JohnsonCookHardening)
+    from skfem_pg.scenes.scene import exact
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 2, 5),
+                                    np.linspace(0, 1, 3)).with_boundaries(
+        {"left": lambda x: x[0] == 0, "right": lambda x: x[0] == 2})
+
+    def key(A=792.0, D1=0.05, sy=None, tol=1e-9):
+        if sy is None:
+            law = J2Plasticity(
+                80.0, 160.0, hardening=JohnsonCookHardening(A, 510.0, 0.26),
+                damage=JohnsonCookDamage(D1, 3.44, -2.12, 1.0))
+        else:
+            law = J2Plasticity(80.0, 160.0, sy, H=0.13)
+        sc = Scene("law", mesh, law, clamped=["left"],
+                   prescribed={"right": {0: 0.01}})
+        return sc.fingerprint(2, "Q2", exact({"tol": tol}))
+    base = key()
+    assert key() == base
+    for kw in ({"A": np.nextafter(792.0, 800.0)},
+               {"D1": np.nextafter(0.05, 1.0)},
+               {"tol": np.nextafter(1e-9, 1.0)}):
+        assert key(**kw) != base, kw
+    assert key(sy=0.45) == key(sy=0.45) != key(sy=np.nextafter(0.45, 1.0))
+
+
+@pytest.mark.parametrize("scheme", ["PG", "Q1"])
+def test_conflicting_or_impossible_conditions_are_named(scheme):
+    """Issue 47: a boundary both clamped and moved solved with the move
+    winning, without a word; two boundaries that share a corner with
+    different values likewise; a component out of range died in an
+    IndexError."""
+    law = mat.NeoHooke(10.0, 4.0)
+    sq = unit_square()
+    sc = Scene("both", sq, law, clamped=["right"],
+               prescribed={"right": {0: 0.1}})
+    with pytest.raises(ValueError, match=r"twice with different values: "
+                       r"clamped 'right' = 0 and prescribed 'right' "
+                       r"component 0 = 0.1"):
+        sc.setup(scheme)
+    corner = Scene("corner", sq, law, prescribed={
+        "left": {0: 0.0, 1: 0.0}, "top": {1: 0.2}})
+    with pytest.raises(ValueError, match=r"dof .* \(at \[0.0, 1.0\]\)"):
+        corner.setup(scheme)
+    # the same value from two conditions is one condition
+    Scene("fine", sq, law, clamped=["left"],
+          prescribed={"bottom": {1: 0.0}, "right": {0: 0.1}}).setup(scheme)
+    for bad, what in (({"right": {2: 0.1}}, "component 2; a 2-D"),
+                      ({"right": {-1: 0.1}}, "component -1"),
+                      ({"right": {0: np.nan}}, "finite number"),
+                      ({"right": 0.1}, "component: value")):
+        with pytest.raises(ValueError, match=what):
+            Scene("bad", sq, law, prescribed=bad)
+
+
+def test_the_thesis_boundary_variant_says_its_load_is_not_the_asked_one():
+    """Issue 47: with vc_boundary 'sn' (the thesis' VCPBG) the applied
+    traction resultant was 22.19 for a requested 22.0, documented only in
+    a docstring; it warns now, with both numbers and V5m named, and V5m
+    applies the requested load to round-off (no warning)."""
+    import warnings
+    import skfem_pg as pg
+    from skfem_pg.errors import SurfaceLoadWarning
+    mesh = pg.meshing.cook_membrane(8).with_boundaries(
+        {"right": lambda x: np.isclose(x[0], 48.0)})
+    for vc_boundary, warns in (("sn", True), ("min-norm", False)):
+        basis = pg.FamilyBasis(mesh, dim=2, vc_boundary=vc_boundary)
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            f = pg.traction(basis, "right", [0.0, 1.0])
+        said = [w for w in seen if issubclass(w.category,
+                                              SurfaceLoadWarning)]
+        assert bool(said) == warns
+        total = f.reshape(-1, 2).sum(axis=0)
+        if warns:
+            assert "min-norm" in str(said[0].message)
+            assert abs(total[1] - 16.0) > 1e-3  # the edge is 16 long
+        else:
+            assert abs(total[1] - 16.0) <= 1e-12 * 16.0

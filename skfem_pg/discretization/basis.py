@@ -63,6 +63,77 @@ from numpy.typing import ArrayLike
 pbg_weights = volume_weights
 
 
+class FamilyDofs(np.ndarray):
+    """:attr:`FamilyBasis.element_dofs`: rows the local dofs, columns the
+    *families* (column ``k``: particle ``k``'s family).  Selecting
+    columns by an index array raises ``IndexError``, since on a
+    scikit-fem basis the same expression selects mesh cells (scikit-fem's
+    ex26: ``basis.element_dofs[:, mesh.subdomains['annulus']]`` picked
+    the families of particles numbered like those cells, and the answer
+    came out 0.0 without a word); rows, slices and single columns index
+    as usual.  ``np.asarray(basis.element_dofs)`` is a plain array."""
+
+    def __getitem__(self, key):
+        plain = np.asarray(self)
+        if isinstance(key, tuple) and len(key) >= 2 and not isinstance(
+                key[1], (slice, int, np.integer, type(Ellipsis))):
+            raise IndexError(
+                "the columns of a FamilyBasis' element_dofs are its "
+                "families (column k: particle k's family), not mesh cells. "
+                "The dofs of the particles on cells C: "
+                "basis.nodal_dofs[:, np.unique(mesh.t[:, C])].ravel() (all "
+                "components); families by number: "
+                "np.asarray(basis.element_dofs)[:, k]")
+        return plain[key]
+
+    @property
+    def T(self):  # the transpose's columns are local dofs: a plain array
+        return np.asarray(self).T
+
+    def transpose(self, *axes):
+        return np.asarray(self).transpose(*axes)
+
+
+#: scikit-fem ``Basis`` keywords a FamilyBasis has no use for, and why
+_FE_KEYWORDS = {
+    "intorder": "a FamilyBasis integrates at its family members (or the "
+                "moment-matched points: family_quadrature='moments'); "
+                "there is no Gauss rule to choose",
+    "quadrature": "a FamilyBasis integrates at its family members (or the "
+                  "moment-matched points: family_quadrature='moments')",
+    "mapping": "a FamilyBasis has no reference element to map",
+    "elements": "collocate the particles from the part of the mesh: "
+                "Particles.from_mesh(mesh.restrict(elements))",
+}
+
+
+def _refuse_fe_arguments(families, unknown):
+    """``TypeError`` naming the PG way for scikit-fem ``Basis`` arguments:
+    an element where ``families`` goes (``FamilyBasis(mesh, element)``,
+    the literal swap of ``Basis(mesh, element)``) and ``Basis`` keywords."""
+    if isinstance(families, (fem.Element, fem.ElementVector)):
+        raise TypeError(
+            "FamilyBasis(mesh, {}()): a FamilyBasis takes no element, each "
+            "particle's family is its element.  For scikit-fem's Basis("
+            "mesh, ElementVector(...)) write FamilyBasis(mesh, "
+            "dim=mesh.dim()) (displacements), for a scalar Basis(mesh, "
+            "element) FamilyBasis(mesh); the second argument is the family "
+            "rule ('mesh', 'kNN', 'horizon', ...)".format(
+                type(families).__name__))
+    if unknown:
+        known = sorted(k for k in unknown if k in _FE_KEYWORDS)
+        if known:
+            raise TypeError("FamilyBasis() got {}={!r}: {}".format(
+                known[0], unknown[known[0]], _FE_KEYWORDS[known[0]]))
+        raise TypeError(
+            "FamilyBasis() got unexpected keyword argument(s) {}; its "
+            "options are families, shape, bond, vc, method, dim, "
+            "weight_exponent, vc_solver, area_vectors, vc_exclude, "
+            "test_shape, lme_mu, vc_boundary, vc_tolerance, distributed, "
+            "weights, family_quadrature".format(
+                ", ".join(map(repr, sorted(unknown)))))
+
+
 class FamilyBasis(AbstractBasis):
     """A scikit-fem basis whose elements are particle families.
 
@@ -235,7 +306,8 @@ class FamilyBasis(AbstractBasis):
                  vc_boundary: str = "min-norm",
                  vc_tolerance: float | None = 1e-8, distributed=None,
                  weights: str = "auto",
-                 family_quadrature: str = "members") -> None:
+                 family_quadrature: str = "members", **unknown) -> None:
+        _refuse_fe_arguments(families, unknown)
         particles = _as_particles(particles)
         spec = BasisSpec.resolve(
             particles, families=families, shape=shape, bond=bond, vc=vc,
@@ -256,6 +328,11 @@ class FamilyBasis(AbstractBasis):
         """The basis of a :class:`~skfem_pg.discretization.builder.BasisSpec`
         (the keyword constructor resolves one and calls the same builder)."""
         particles = _as_particles(particles)
+        if spec.dim is not None and spec.dim != particles.dim:
+            raise ValueError(
+                "the spec was resolved for dim={} components, the particles "
+                "are {}-D: resolve it on these particles (BasisSpec.resolve("
+                "particles, ...))".format(spec.dim, particles.dim))
         basis = cls.__new__(cls)
         basis._hold(particles, spec, builder.build(
             particles, spec, area_vectors=area_vectors,
@@ -359,8 +436,9 @@ class FamilyBasis(AbstractBasis):
             nc = 1 if self.ncomp is None else self.ncomp
             mem = self.families.padded()[0]
             nf, m = mem.shape
-            self._element_dofs = (nc * mem[:, :, None] + np.arange(nc)) \
-                .reshape(nf, nc * m).T.astype(np.int64)
+            self._element_dofs = np.ascontiguousarray(
+                (nc * mem[:, :, None] + np.arange(nc)).reshape(nf, nc * m)
+                .T.astype(np.int64)).view(FamilyDofs)
         return self._element_dofs
 
     @property
@@ -537,6 +615,38 @@ class FamilyBasis(AbstractBasis):
         return self._collocation_basis("probes").probes(
             np.asarray(x, dtype=float))
 
+    def point_source(self, x):
+        """The right-hand side of a unit point source at ``x``
+        (``(dim,)``), as scikit-fem's ``CellBasis.point_source``: the
+        values at ``x`` of the interpolant :meth:`probes` uses, one entry
+        per particle dof (a scalar basis; for a vector basis give each
+        component's load through :meth:`probes`)."""
+        x = np.asarray(x, dtype=float)
+        d = self.particles.dim
+        if x.shape != (d,):
+            raise ValueError("point_source takes one point of shape ({},), "
+                             "got shape {}".format(d, x.shape))
+        if self.ncomp is not None:
+            raise ValueError(
+                "point_source is a scalar basis' load; on a vector basis "
+                "(dim={}) put a point force F at x as P = basis.probes("
+                "x[:, None]) on each component: f[basis.nodal_dofs[c]] += "
+                "F[c] * P.toarray()[0]".format(self.ncomp))
+        return self.probes(x[:, None]).toarray()[0]
+
+    def interpolator(self, y):
+        """A function of points ``x`` (``(dim, n)``, or with trailing
+        axes) returning the field ``y`` there, as scikit-fem's
+        ``CellBasis.interpolator`` (the interpolant of :meth:`probes`)."""
+        y = np.asarray(y)
+
+        def interpfun(x):
+            x = np.asarray(x, dtype=float)
+            shape = x.shape
+            out = self.probes(x.reshape(shape[0], -1)) @ y
+            return out.reshape(shape[1:]) if len(shape) > 2 else out
+        return interpfun
+
     def project(self, interp, **kwargs):
         r"""Particle values of ``interp``: a callable of positions ``x``
         (``(dim, n)``, returning ``(n,)`` or ``(ncomp, n)``) or a dof
@@ -557,9 +667,14 @@ class FamilyBasis(AbstractBasis):
             v = np.asarray(interp(self.particles.x), dtype=float)
             if v.shape not in ((nc, self.particles.n),) + (
                     ((self.particles.n,),) if nc == 1 else ()):
-                raise ValueError("the projected function must return shape "
-                                 "{}, got {}".format(
-                                     (nc, self.particles.n), v.shape))
+                raise ValueError(
+                    "the projected function is called with the particle "
+                    "positions x of shape (dim, n) = {} (not scikit-fem's "
+                    "(dim, elements, points)) and must return {}, got {}"
+                    .format(self.particles.x.shape,
+                            "(n,) or (1, n)" if nc == 1
+                            else "(ncomp, n) = {}".format(
+                                (nc, self.particles.n)), v.shape))
             return v.reshape(nc, -1).T.ravel()
         v = np.asarray(interp)
         if isinstance(interp, DiscreteField) or v.shape != (self.N,):

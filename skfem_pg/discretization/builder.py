@@ -242,6 +242,14 @@ class BasisSpec:
         if ppg and weights not in ("auto", None, "volume"):
             raise ValueError("weights={!r} is a PBG option: PPG integrates "
                              "with the member volumes V^j".format(weights))
+        if vc_tolerance is not None and not (
+                isinstance(vc_tolerance, (int, float, np.number))
+                and np.isfinite(vc_tolerance) and vc_tolerance > 0):
+            raise ValueError(
+                "vc_tolerance must be a positive number (the largest VC "
+                "constraint residual accepted, default 1e-8) or None (keep "
+                "any correction, with a warning), got {!r}".format(
+                    vc_tolerance))
         if family_quadrature not in ("members", "moments"):
             raise ValueError("family_quadrature must be 'members' or "
                              "'moments', got {!r}".format(family_quadrature))
@@ -432,6 +440,12 @@ def area_vectors_of(particles, area_vectors):
     if area_vectors.shape != x.shape:
         raise ValueError("area_vectors must have shape {}, got {}"
                          .format(x.shape, area_vectors.shape))
+    bad = np.flatnonzero(~np.all(np.isfinite(area_vectors), axis=0))
+    if len(bad):
+        raise ValueError("area_vectors of {} particles are not finite "
+                         "(first: {}, area vector {})".format(
+                             len(bad), describe_particle(bad[0], x[:, bad[0]]),
+                             area_vectors[:, bad[0]].tolist()))
     return area_vectors
 
 

@@ -168,12 +168,37 @@ class BondBased:
             raise ValueError("BondBased: plane must be 'strain' or 'stress', "
                              "got {!r}".format(plane))
         self.plane, self.nu = key, POISSON[key]
+        empty = np.flatnonzero(~(p.volumes > 0))
+        if len(empty):
+            raise ValueError(
+                "BondBased: {} of {} particles have no volume (first: "
+                "particle {} at {}) — particles outside the elements they "
+                "were collocated from carry neither mass nor bonds; "
+                "collocate from the part itself (mesh.restrict(elements))"
+                .format(len(empty), p.n, empty[0],
+                        np.round(p.x[:, empty[0]], 12).tolist()))
         spacing = float(np.median(p.volumes ** (1.0 / p.dim)))
-        self.horizon = delta = float(horizon) * (1.0 if absolute
-                                                 else spacing)
-        if not delta > 0:
-            raise ValueError("BondBased: the horizon must be positive, got "
-                             "{}".format(horizon))
+        try:
+            delta = float(horizon) * (1.0 if absolute else spacing)
+        except (TypeError, ValueError):
+            raise ValueError("BondBased: the horizon must be a number, got "
+                             "{!r}".format(horizon)) from None
+        if not (np.isfinite(delta) and delta > 0):
+            raise ValueError("BondBased: the horizon must be a positive "
+                             "finite {}, got {!r}".format(
+                                 "length" if absolute else
+                                 "multiple of the particle spacing",
+                                 horizon))
+        size = float(np.linalg.norm(np.ptp(p.x, axis=1)))
+        if delta >= size:
+            raise ValueError(
+                "BondBased: the horizon {:g} spans the whole body (its "
+                "diameter is {:g}): every particle bonds with every other "
+                "and the micromodulus (~1/horizon^{}) vanishes; give a "
+                "horizon of a few particle spacings (the spacing is {:g}; "
+                "the default is 3 spacings)".format(delta, size, p.dim + 1,
+                                                    spacing))
+        self.horizon = delta
         self.E, self.G0 = E, None if G0 is None else float(G0)
         if self.G0 is not None and not self.G0 > 0:
             raise ValueError("BondBased: the fracture energy G0 must be "

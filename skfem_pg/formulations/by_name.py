@@ -45,6 +45,10 @@ def _displacement(basis, material, tangent):
     return Hyperelastic(basis, material, tangent=tangent)
 
 
+#: the scene builds :class:`UpdatedLagrange` for this build in the UL frame
+_displacement.updated_lagrangian = True
+
+
 def _mean_dilatation(token, incompressible):
     """UnlP0 / IUnlP0: the PBG model, at the master on a PPG basis."""
     pbg, ppg = ((IncompressibleP0, MasterIncompressible) if incompressible

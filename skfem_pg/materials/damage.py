@@ -51,6 +51,11 @@ class JohnsonCookDamage:
         if self.D2 < 0:
             raise ValueError("JohnsonCookDamage: D2 must be >= 0, got {}"
                              .format(D2))
+        if self.D2 == 0 and self.D1 <= 0:
+            raise ValueError(
+                "JohnsonCookDamage: with D2 = 0 the failure strain is D1 = "
+                "{} at every triaxiality, and D1 <= 0 fails every point at "
+                "its first plastic step; give D1 > 0 (or D2 > 0)".format(D1))
         if not 0 < self.Dc <= 1:
             raise ValueError("JohnsonCookDamage: the critical damage Dc must "
                              "lie in (0, 1], got {}".format(Dc))
@@ -62,7 +67,11 @@ class JohnsonCookDamage:
     def failure_strain(self, triaxiality):
         r""":math:`\varepsilon_f(\sigma^*) = D_1 + D_2 e^{D_3\sigma^*}`."""
         t = np.asarray(triaxiality, dtype=float)
-        return self.D1 + self.D2 * np.exp(self.D3 * t)
+        if self.D2 == 0:  # no 0 * inf where D3 t overflows
+            return np.full(t.shape, self.D1)
+        # exp saturates at inf (no failure) instead of overflowing to nan
+        with np.errstate(over="ignore"):
+            return self.D1 + self.D2 * np.exp(self.D3 * t)
 
     def increment(self, dalpha, triaxiality):
         r""":math:`\Delta D = \Delta\bar e_p / \varepsilon_f(\sigma^*)`

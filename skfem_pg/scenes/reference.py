@@ -24,7 +24,7 @@ import skfem as fem
 from ..formulations.linear import linear_elasticity
 from .meshing import cook_membrane
 from .. import registry
-from .scene import centroid_tree, inside
+from .scene import centroid_tree, exact, inside
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
@@ -32,8 +32,9 @@ QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 #: bump when the stored content changes meaning (3: prescribed components
 #: of quadratic elements constrain their facet dofs too; 4: the key holds
 #: the callable loads' values, the load steps and the solve keywords, the
-#: file its format and a checksum of its content)
-CACHE_FORMAT = 4
+#: file its format and a checksum of its content; 5: nested laws and
+#: solve keywords in the key by their exact values, not their repr)
+CACHE_FORMAT = 5
 
 
 def cache_dir():
@@ -177,8 +178,7 @@ def overkill(scene, refine=2, method=None, verbose=True, **solve_kwargs):
             fem.MeshHex1: "H1"}[type(scene.mesh)]
     method = method or QUADRATIC[base]
     key = scene.fingerprint(refine, method, CACHE_FORMAT,
-                            sorted((k, repr(v))
-                                   for k, v in solve_kwargs.items()))
+                            exact(solve_kwargs))
     fn = os.path.join(cache_dir(), "{}-{}.npz".format(cache_name(scene.name),
                                                       key[:20]))
     mesh = scene.mesh.refined(refine) if refine else scene.mesh

@@ -104,6 +104,36 @@ class Scene:
         self.steps = steps
         self.params = params or {}
         self._check_boundaries()
+        self._check_prescribed()
+
+    def _check_prescribed(self):
+        """``prescribed`` values: a callable ``f(x, t)`` or a dict of
+        displacement components ``0 ... dim - 1`` to finite numbers (else
+        ``ValueError`` naming the boundary, here rather than an
+        ``IndexError`` at :meth:`solve`)."""
+        d = self.dim
+        for name, how in self.prescribed.items():
+            if callable(how):
+                continue
+            if not isinstance(how, dict):
+                raise ValueError(
+                    "prescribed[{!r}] must be {{component: value}} or a "
+                    "callable f(x, t), got {!r}".format(name, how))
+            for c, val in how.items():
+                if isinstance(c, bool) or not isinstance(
+                        c, (int, np.integer)) or not 0 <= c < d:
+                    raise ValueError(
+                        "prescribed[{!r}] names component {!r}; a {}-D "
+                        "displacement has components 0 ... {}".format(
+                            name, c, d, d - 1))
+                try:
+                    ok = np.isfinite(float(val))
+                except (TypeError, ValueError):
+                    ok = False
+                if not ok:
+                    raise ValueError(
+                        "prescribed[{!r}][{}] must be a finite number, got "
+                        "{!r}".format(name, c, val))
 
     def _check_boundaries(self):
         """Every boundary the scene names exists on the mesh (else a
@@ -130,21 +160,7 @@ class Scene:
         """Text that identifies the problem apart from the mesh: name,
         material (type and every parameter at full precision),
         boundary conditions, loads, probes and parameters."""
-        def exact(v):
-            if isinstance(v, (float, np.floating)):
-                return float(v).hex()
-            if isinstance(v, np.ndarray):
-                return [exact(a) for a in v.ravel().tolist()]
-            if isinstance(v, dict):
-                return sorted((str(k), exact(a)) for k, a in v.items())
-            if isinstance(v, (list, tuple)):
-                return [exact(a) for a in v]
-            if callable(v):
-                return _callable_key(v)
-            return repr(v)
-        material = (type(self.material).__module__,
-                    type(self.material).__qualname__,
-                    exact(vars(self.material)))
+        material = exact(self.material)
         return repr((self.name, material, exact(list(self.clamped)),
                      exact(self.prescribed),
                      exact({k: v if callable(v) else np.asarray(v, float)
@@ -225,8 +241,10 @@ class Scene:
         """Prescribed dofs ``D`` and their values as a function of the
         load factor, ``u_D(t)`` (a full-length vector)."""
         D, const, moving = [], np.zeros(basis.N), []
+        claims = []  # (dofs, values at load factor 1, what prescribes)
         for name in self.clamped:
             D.append(basis.get_dofs(name).flatten())
+            claims.append((D[-1], 0.0, "clamped {!r}".format(name)))
         d = self.dim
         for name, how in self.prescribed.items():
             dofs = basis.get_dofs(name)
@@ -240,6 +258,9 @@ class Scene:
             for c, val in how.items():
                 D.append(idx[c])
                 const[idx[c]] = val
+                claims.append((idx[c], float(val), "prescribed {!r} "
+                               "component {}".format(name, c)))
+        self._check_claims(basis, claims)
         D = np.unique(np.concatenate(D)) if D else np.zeros(0, int)
         locs = basis.doflocs
 
@@ -258,6 +279,35 @@ class Scene:
                     u[idx[c]] = val[c]
             return u
         return D, u_D
+
+    @staticmethod
+    def _check_claims(basis, claims):
+        """A dof that two constant conditions prescribe with different
+        values (a boundary both clamped and moved, or two boundaries that
+        share nodes) raises ``ValueError`` naming both and the position:
+        the one written last would win without a word."""
+        if len(claims) < 2:
+            return
+        dofs = np.concatenate([np.asarray(c[0], dtype=np.int64)
+                               for c in claims])
+        vals = np.concatenate([np.full(len(c[0]), c[1]) for c in claims])
+        who = np.concatenate([np.full(len(c[0]), i)
+                              for i, c in enumerate(claims)])
+        order = np.lexsort((vals, dofs))
+        dofs, vals, who = dofs[order], vals[order], who[order]
+        same = dofs[1:] == dofs[:-1]
+        clash = np.flatnonzero(same & (vals[1:] != vals[:-1]))
+        if len(clash):
+            i = clash[0]
+            x = basis.doflocs[:, dofs[i]]
+            raise ValueError(
+                "the scene prescribes dof {} (at {}) twice with different "
+                "values: {} = {:g} and {} = {:g} ({} such dofs); give each "
+                "boundary one condition (e.g. drop it from clamped=, or "
+                "name the shared nodes' boundary once)".format(
+                    dofs[i], np.round(x, 12).tolist(), claims[who[i]][2],
+                    vals[i], claims[who[i + 1]][2], vals[i + 1],
+                    len(np.unique(dofs[clash]))))
 
     def _fe_traction(self, basis, mesh, name, t):
         what = "the traction t(x) on {!r}" if callable(t) \
@@ -354,8 +404,11 @@ class Scene:
             basis = FamilyBasis(Particles.from_mesh(mesh), dim=self.dim,
                                 **basis_kwargs)
             if frame_of(scheme) == "UL":
-                model = UpdatedLagrange(basis, self.material,
-                                        every=self.params.get("ul_every", 1))
+                every = self.params.get("ul_every", 1)
+                build_ul = registry.formulation(formulation).build_ul
+                model = (UpdatedLagrange(basis, self.material, every=every)
+                         if build_ul is None
+                         else build_ul(basis, self.material, every))
             else:
                 model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
@@ -416,6 +469,38 @@ def _scheme(scheme, basis_kwargs):
                              method, ", ".join(registry.fe_names()),
                              err)) from None
     return "PG", formulation_of(method), {**kw, **basis_kwargs}
+
+
+def exact(v, depth=0):
+    """A reproducible description of a value for cache keys, exact to the
+    bit: floats by their hex form, arrays entry by entry, containers
+    recursively, functions by :func:`_callable_key` and any other object
+    (a material and the hardening and damage laws it holds) by its type
+    and its attributes, recursively (an object's ``repr`` rounds: 6
+    digits in the laws' — two laws with A = 792 and 792.00008 shared a
+    cached reference)."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v).hex()
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (str, type(None))):
+        return v
+    if isinstance(v, np.ndarray):
+        return [exact(a, depth + 1) for a in v.ravel().tolist()] \
+            + [v.shape]
+    if isinstance(v, dict):
+        return sorted((str(k), exact(a, depth + 1)) for k, a in v.items())
+    if isinstance(v, (list, tuple)):
+        return [exact(a, depth + 1) for a in v]
+    if callable(v) and not hasattr(v, "__dict__") or \
+            hasattr(v, "__code__"):
+        return _callable_key(v)
+    if hasattr(v, "__dict__") and depth < 8:
+        return (type(v).__module__, type(v).__qualname__,
+                exact(vars(v), depth + 1))
+    return repr(v)
 
 
 def _callable_key(f):

@@ -11,8 +11,11 @@ resumed after a crash and end where the uninterrupted run ends.
   intact.
 * A checkpoint carries the fingerprint of its model (:func:`fingerprint`:
   formulation, material and its parameters, basis, the particle or node
-  positions, counts); loading it into another model raises a
-  ``ValueError`` naming what differs.
+  positions, the mesh's cells, counts) and the kind of run that wrote it
+  (:data:`KINDS`); loading it into another model, or resuming it by
+  another kind of driver, raises a ``ValueError`` naming what differs.
+* :func:`save` checks what it writes: one finite value per unknown, a
+  finite load factor (in [0, 1] for a static run) or time.
 * ``path`` may be given with or without its ``.npz`` suffix.
 """
 import hashlib
@@ -26,8 +29,18 @@ import numpy as np
 from ..naming import name_of
 from ..discretization.layout import is_family_basis
 
-#: bump when the stored content changes meaning
-FORMAT = 2
+#: bump when the stored content changes meaning (3: the mesh's cells in
+#: the fingerprint, the driver kind)
+FORMAT = 3
+
+#: the drivers that write checkpoints: ``"static"`` (:func:`~skfem_pg.
+#: solvers.newton`, ``load`` a load factor), ``"newmark"`` and
+#: ``"explicit"`` (:func:`~skfem_pg.solvers.newmark`,
+#: :func:`~skfem_pg.solvers.central_difference`: ``load`` the time)
+KINDS = ("static", "newmark", "explicit")
+#: the drivers of :data:`KINDS`, for messages
+RUNS = {"static": "a static run (newton)", "newmark": "a Newmark run",
+        "explicit": "an explicit run (central_difference)"}
 
 
 def _path(path):
@@ -58,7 +71,9 @@ def fingerprint(model):
     """What a checkpoint must match, as ``{field: text}``: the
     formulation, its material (type and parameters, full precision), the
     basis (family basis: its thesis code; FE: the element), the node or
-    particle positions (a hash) and the number of unknowns."""
+    particle positions (a hash), the cells of its mesh (a hash: another
+    triangulation of the same vertices differs) and the number of
+    unknowns."""
     basis = model.basis
     material = getattr(model, "material", None)
     material = getattr(material, "material", material)  # a History's law
@@ -73,17 +88,57 @@ def fingerprint(model):
             "material": json.dumps(_describe(material), sort_keys=True),
             "basis": kind,
             "positions": _digest(basis.doflocs),
+            "cells": _cells(basis),
             "unknowns": str(getattr(model, "N", basis.N))}
 
 
-def save(path, model, x, load=1.0, **state):
+def _cells(basis):
+    """A hash of the cells of the basis' mesh (``"none"`` without one)."""
+    mesh = getattr(basis, "mesh", None)
+    t = getattr(mesh, "t", None)
+    if t is None:
+        return "none"
+    t = np.ascontiguousarray(np.asarray(t, dtype=np.int64))
+    return "{} {}".format(t.shape, hashlib.sha1(t.tobytes()).hexdigest()[:16])
+
+
+def save(path, model, x, load=1.0, kind=None, **state):
     """Write ``x`` (all unknowns of ``model``), the load factor (or time)
     ``load``, the committed history of a plastic ``model``, the model's
-    :func:`fingerprint` and ``state`` (further arrays or numbers, e.g. a
-    driver's step controller) to ``path`` atomically.  Returns the path
-    written (with ``.npz``)."""
+    :func:`fingerprint`, the ``kind`` of run (:data:`KINDS`, or ``None``:
+    any driver may resume it that finds its state) and ``state`` (further
+    arrays or numbers, e.g. a driver's step controller) to ``path``
+    atomically.  Returns the path written (with ``.npz``).
+
+    Raises ``ValueError`` for ``x`` of another length than the model's
+    unknowns or with non-finite entries, a non-finite ``load``, a static
+    load factor outside [0, 1], a negative time, an unknown ``kind``."""
     path = _path(path)
-    arrays = {"x": np.asarray(x, dtype=float), "load": float(load),
+    x = np.asarray(x, dtype=float)
+    n = getattr(model, "N", model.basis.N)
+    if x.shape != (n,):
+        raise ValueError("checkpoint.save: x has shape {}, the model has {} "
+                         "unknowns".format(x.shape, n))
+    bad = np.flatnonzero(~np.isfinite(x))
+    if len(bad):
+        raise ValueError("checkpoint.save: x has {} non-finite entries "
+                         "(first: unknown {} = {})".format(len(bad), bad[0],
+                                                          x[bad[0]]))
+    if kind is not None and kind not in KINDS:
+        raise ValueError("checkpoint.save: kind must be one of {} or None, "
+                         "got {!r}".format(", ".join(KINDS), kind))
+    try:
+        load = float(load)
+    except (TypeError, ValueError):
+        raise ValueError("checkpoint.save: load must be a number, got {!r}"
+                         .format(load)) from None
+    if not np.isfinite(load) or (kind == "static" and not 0 <= load <= 1) \
+            or (kind in ("newmark", "explicit") and load < 0):
+        raise ValueError(
+            "checkpoint.save: load = {!r} is not a {}".format(
+                load, "load factor in [0, 1]" if kind == "static"
+                else "time >= 0" if kind else "finite number"))
+    arrays = {"x": x, "load": load, "kind": kind or "",
               "format": FORMAT,
               "fingerprint": json.dumps(fingerprint(model), sort_keys=True)}
     h = getattr(model, "history", None)
@@ -114,13 +169,15 @@ def atomic_savez(path, **arrays):
     return path
 
 
-def load(path, model, state=False):
+def load(path, model, state=False, kind=None, needs=()):
     """Read a checkpoint of :func:`save` into ``model`` (its history) and
     return ``(x, load)``, or ``(x, load, state)`` with ``state=True`` (the
     dict of further named state).  A checkpoint of another model — its
     :func:`fingerprint` differs: formulation, material, basis, positions,
-    unknowns — raises ``ValueError`` naming the difference, and so does an
-    unreadable file (naming its path)."""
+    cells, unknowns — raises ``ValueError`` naming the difference, and so
+    do an unreadable file or one that is no checkpoint (naming its path),
+    a checkpoint written by another ``kind`` of run than the one given
+    (:data:`KINDS`), and one without the state entries ``needs``."""
     path = _path(path)
     try:
         with np.load(path) as f:
@@ -128,12 +185,31 @@ def load(path, model, state=False):
     except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
         raise ValueError("checkpoint {} cannot be read ({}: {})".format(
             path, type(err).__name__, err)) from None
+    if "fingerprint" not in data or "x" not in data:
+        raise ValueError(
+            "{} is not a skfem-pg checkpoint (its arrays: {}); checkpoints "
+            "are written by the drivers' checkpoint= or by "
+            "skfem_pg.solvers.checkpoint.save".format(
+                path, ", ".join(sorted(data)) or "none"))
     fmt = int(data["format"]) if "format" in data else 1
     if fmt != FORMAT:
-        raise ValueError("checkpoint {} has format {}, this version reads "
-                         "{}".format(path, fmt, FORMAT))
+        raise ValueError("checkpoint {} has format {} (an earlier "
+                         "skfem-pg), this version reads {}: run again from "
+                         "the start".format(path, fmt, FORMAT))
+    written = str(data["kind"]) if "kind" in data else ""
+    if kind is not None and written and written != kind:
+        raise ValueError(
+            "checkpoint {} was written by {}; {} cannot resume it".format(
+                path, RUNS.get(written, written), RUNS.get(kind, kind)))
+    missing = [k for k in needs if "state_" + k not in data]
+    if missing:
+        raise ValueError(
+            "checkpoint {} lacks the state of {} ({}): it was not written "
+            "by that driver".format(path, RUNS.get(kind, "this driver"),
+                                    ", ".join(missing)))
     mine, theirs = fingerprint(model), json.loads(str(data["fingerprint"]))
-    for k in ("unknowns", "formulation", "basis", "material", "positions"):
+    for k in ("unknowns", "formulation", "basis", "material", "positions",
+              "cells"):
         if mine[k] != theirs.get(k):
             raise ValueError(
                 "checkpoint {} was written for another model — {}: {} in "

@@ -116,6 +116,12 @@ class NewtonControls(Controls):
         check_controls(steps=self.steps, tol=self.tol, maxiter=self.maxiter,
                         min_step=self.min_step)
         check_verbose(self.verbose)
+        if self.adaptive and 1.0 / self.steps < self.min_step:
+            raise ValueError(
+                "steps = {} asks for load steps of {:.3g}, below min_step = "
+                "{:.3g}, where a failed step stops the run: use fewer steps "
+                "or a smaller min_step".format(self.steps, 1.0 / self.steps,
+                                               self.min_step))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -125,7 +131,8 @@ class NewmarkControls(Controls):
     Attributes
     ----------
     beta, gamma
-        Newmark's parameters (default average acceleration, 1/4 and 1/2).
+        Newmark's parameters (default average acceleration, 1/4 and 1/2;
+        ``gamma >= 1/2``).
     dt_min
         Smallest step before the run stops (default ``dt / 1024``).
     tol, maxiter, line_search
@@ -150,8 +157,17 @@ class NewmarkControls(Controls):
     verbose: object = "auto"
 
     def __post_init__(self):
-        if not (0 < self.beta and 0 < self.gamma):
-            raise ValueError("beta and gamma must be positive")
+        if not (np.isfinite(self.beta) and np.isfinite(self.gamma)
+                and 0 < self.beta and 0 < self.gamma):
+            raise ValueError("beta and gamma must be positive numbers, got "
+                             "beta = {!r}, gamma = {!r}".format(self.beta,
+                                                               self.gamma))
+        if self.gamma < 0.5:
+            raise ValueError(
+                "gamma = {!r} < 1/2 makes Newmark's method add energy "
+                "(negative numerical damping: a run's energy balance drifts "
+                "by tens of per cent); use gamma >= 1/2 (1/2: no damping)"
+                .format(self.gamma))
         check_controls(tol=self.tol, maxiter=self.maxiter)
         check_verbose(self.verbose)
         _positive_int(self.max_contact_passes, "max_contact_passes")
@@ -165,7 +181,8 @@ class ExplicitControls(Controls):
     Attributes
     ----------
     safety
-        The step is ``safety · 2/ω_max`` when no ``dt`` is given.
+        The step is ``safety · 2/ω_max`` when no ``dt`` is given; in
+        (0, 1].
     estimate_every
         Steps between estimates of ``ω_max``.
     output_every
@@ -186,9 +203,11 @@ class ExplicitControls(Controls):
     verbose: object = "auto"
 
     def __post_init__(self):
-        if not (np.isfinite(self.safety) and self.safety > 0):
-            raise ValueError("safety must be a positive factor of the "
-                             "stable step, got {!r}".format(self.safety))
+        if not (np.isfinite(self.safety) and 0 < self.safety <= 1):
+            raise ValueError("safety must be a factor in (0, 1] of the "
+                             "stable step 2/omega_max (above 1 the central "
+                             "differences are unstable), got {!r}".format(
+                                 self.safety))
         _positive_int(self.estimate_every, "estimate_every")
         check_verbose(self.verbose)
         if self.output_every is not None:

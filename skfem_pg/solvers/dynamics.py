@@ -259,13 +259,19 @@ class Progress:
               file=self.echo.stream or sys.stdout, flush=True)
 
 
-def resume_run(path, model, energy, hist):
+def resume_run(path, model, energy, hist, kind, controller=()):
     """The state a time-stepping checkpoint holds (:func:`save_run`):
     ``(x, t, v, a, f_int, held, saved)``; the energy accounts and the
     records are restored into ``energy`` and ``hist``, the model's
     history by :func:`~skfem_pg.solvers.checkpoint.load`.  ``saved``
-    holds the integrator's own entries (its step controller)."""
-    x, t, saved = load_checkpoint(path, model, state=True)
+    holds the integrator's own entries (its step controller: the names
+    ``controller``).  A checkpoint of another ``kind`` of run
+    (``"newmark"``, ``"explicit"``; a static one) or without these
+    entries raises ``ValueError``."""
+    needs = ("v", "a", "f_int", "held", "records") \
+        + tuple(energy.accounts()) + tuple(controller)
+    x, t, saved = load_checkpoint(path, model, state=True, kind=kind,
+                                  needs=needs)
     energy.restore(saved)
     hist[:] = history_of(saved["records"])
     return (x, t, saved["v"], saved["a"], saved["f_int"],
@@ -273,13 +279,14 @@ def resume_run(path, model, energy, hist):
 
 
 def save_run(every, count, model, x, t, v, a, f_int, held, energy, hist,
-             **controller):
+             kind, **controller):
     """Write a time-stepping run's state (unknowns, velocities,
     accelerations, internal force, held dofs, energy accounts, records and
     the integrator's ``controller`` entries) through ``every``
     (:class:`~skfem_pg.solvers.checkpoint.Every`, atomically) at the
-    ``count``-th step."""
-    every.save(count, model, x, t, v=v, a=a, f_int=f_int,
+    ``count``-th step; ``kind`` the integrator (``"newmark"``,
+    ``"explicit"``)."""
+    every.save(count, model, x, t, kind=kind, v=v, a=a, f_int=f_int,
                held=held.astype(float), records=history_text(hist),
                **energy.accounts(), **controller)
 

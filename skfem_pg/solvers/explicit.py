@@ -382,7 +382,9 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
     if resume is None:
         output()
     else:
-        u, t, v, a, fi, held, saved = resume_run(resume, model, energy, hist)
+        u, t, v, a, fi, held, saved = resume_run(
+            resume, model, energy, hist, "explicit",
+            controller=("steps", "step", "base", "output_every"))
         steps, step, base = int(saved["steps"]), float(saved["step"]), \
             float(saved["base"])
         output_every = int(saved["output_every"])
@@ -453,7 +455,7 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             progress(t, h, steps, rec_err)
         if every is not None:
             save_run(every, steps, model, u, t, v, a, fi, held, energy, hist,
-                     steps=steps, step=step, base=base,
+                     "explicit", steps=steps, step=step, base=base,
                      output_every=output_every,
                      **({} if F_est is None else {"F_est": F_est}))
     times["total"] = time.perf_counter() - t_start

@@ -173,7 +173,9 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
     hist = out.hist
     t, steps, step, cuts = 0.0, 0, float(dt), 0
     if resume is not None:
-        x, t, v, a, fi, held, saved = resume_run(resume, model, energy, hist)
+        x, t, v, a, fi, held, saved = resume_run(
+            resume, model, energy, hist, "newmark",
+            controller=("step", "steps", "cuts"))
         step, steps, cuts = float(saved["step"]), int(saved["steps"]), \
             int(saved["cuts"])
         state = model.state(x)
@@ -227,7 +229,7 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
             output(info, final)
         if every is not None:
             save_run(every, steps, model, x, t, v, a, fi, held, energy, hist,
-                     step=step, steps=steps, cuts=cuts)
+                     "newmark", step=step, steps=steps, cuts=cuts)
     times["total"] = sum(times.values())
     return Trajectory(x, v, a, t, hist, steps, times)
 

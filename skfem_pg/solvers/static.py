@@ -191,7 +191,12 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
         if u0 is not None or load0:
             raise ValueError("resume= starts from its checkpoint: give "
                              "neither u0 nor load0 with it")
-        u, lam, saved = load_checkpoint(resume, model, state=True)
+        u, lam, saved = load_checkpoint(resume, model, state=True,
+                                        kind="static")
+        if not 0.0 <= lam <= 1.0:
+            raise ValueError(
+                "checkpoint {} holds load factor {!r}; a static run resumes "
+                "from a load factor in [0, 1]".format(resume, lam))
         dlam = float(saved.get("step", dlam))
         if "prev_x" in saved:
             prev = (float(saved["prev_load"]), saved["prev_x"])
@@ -271,7 +276,8 @@ def load_stepping(model, step, algebra, u, lam, dlam, options, prev=None,
                     else len(info["residuals"]) <= 5):
                 dlam = min(2 * dlam, 1.0)
             if every is not None:  # before the callback, which may fail
-                every.save(len(history), model, u, lam, step=dlam,
+                every.save(len(history), model, u, lam, kind="static",
+                           step=dlam,
                            **({} if prev is None else
                               {"prev_load": prev[0], "prev_x": prev[1]}))
             if callback is not None:
