@@ -394,3 +394,29 @@ def test_crack_aware_u1sig_on_the_notched_strip():
     k = np.repeat(fam.masters, fam.sizes)
     assert np.array_equal(piece[k], piece[np.asarray(fam.members)])
     assert abs(tr.history[-1]["relative_error"]) < 1e-3
+
+
+def test_a_crack_checkpoint_is_refused_on_another_triangulation(tmp_path):
+    """Issue 47: a crack-aware checkpoint loaded into a model on another
+    triangulation of the same vertices (same cell count) applied its
+    crack mask to other cells; the fingerprint hashes the cells now."""
+    from skfem_pg.solvers import checkpoint
+    quads = fem.MeshQuad.init_tensor(*(np.linspace(0, 1, 7),) * 2)
+    q = quads.t
+    a = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]]))
+    b = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 3]], q[[1, 2, 3]]]))
+    model = CrackAware(pg.FamilyBasis(a, dim=2, families="mesh"), STEEL)
+    u = np.zeros(model.N)
+    st = model.state(u)
+    model.commit(st)
+    c = a.p[:, a.t].mean(axis=1)
+    one = np.zeros(a.nelements, dtype=bool)
+    one[np.argmin(np.hypot(c[0] - 0.5, c[1] - 0.5))] = True
+    model.update(u, np.array(st["F"]), one)
+    path = checkpoint.save(tmp_path / "crack", model, u, 0.5)
+    other = CrackAware(pg.FamilyBasis(b, dim=2, families="mesh"), STEEL)
+    with pytest.raises(ValueError, match="cells"):
+        checkpoint.load(path, other)
+    same = CrackAware(pg.FamilyBasis(a, dim=2, families="mesh"), STEEL)
+    checkpoint.load(path, same)
+    assert np.array_equal(same.intact, model.intact)
