@@ -305,3 +305,27 @@ def test_cell_values_find_every_bond_midpoint_vectorized():
     from skfem_pg.discretization import coefficients
     result = doctest.testmod(coefficients)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_fe_quadrature_data_on_the_generic_path_is_named():
+    """Issue 47 (scikit-fem's ex17): a P0 field interpolated at an FE
+    basis' quadrature points, handed to scikit-fem's own assembly on a
+    FamilyBasis, died in scikit-fem's "Quadrature mismatch"; the PG ways
+    are named now, as on the fast path."""
+    import warnings
+    from skfem.helpers import dot, grad
+    mesh = fem.MeshQuad.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+    basis = pg.FamilyBasis(mesh)
+    k_cells = np.ones(mesh.nelements)
+
+    @fem.BilinearForm
+    def conduction_generic(u, v, w):
+        return w.k * dot(grad(u), grad(v))
+    p0 = fem.Basis(mesh, fem.ElementQuad0()).interpolate(k_cells)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ValueError, match="integrates at its family "
+                                             "members"):
+            conduction_generic.assemble(basis, k=p0)
+        with pytest.raises(ValueError, match="cell_values_at_members"):
+            conduction_generic.assemble(basis, k=k_cells)

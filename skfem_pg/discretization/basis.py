@@ -857,6 +857,12 @@ def _check_generic_assembly(basis, frame):
         return
     loc = frame.f_locals
     u, v = loc.get("ubasis", basis), loc.get("vbasis", basis)
+    kwargs = loc.get("kwargs")
+    if isinstance(kwargs, dict) and kwargs:
+        # FE quadrature data or another element's dofs: named here, before
+        # scikit-fem's "Quadrature mismatch" / "wrong size"
+        from .assembly import check_coefficients
+        check_coefficients(basis, kwargs)
     if v is not u and u is basis:  # once per form, from the trial side
         warn_equal_order_mixed(u, v)
     if not isinstance(form, fem.LinearForm):  # bilinear (or trilinear)
