@@ -157,14 +157,28 @@ class VTUSeries:
             time, sub, name) for time, name in self.entries]
         text.append('</Collection>\n</VTKFile>\n')
         # atomically: a kill during the write keeps the previous collection
-        path = os.path.normpath(self.folder) + ".pvd"
-        fd, tmp = tempfile.mkstemp(dir=os.path.dirname(os.path.abspath(path)),
-                                   prefix=".pvd-", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write("".join(text))
-            os.replace(tmp, path)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        atomic_write(os.path.normpath(self.folder) + ".pvd",
+                     lambda f: f.write("".join(text).encode()))
         return fn
+
+
+def atomic_write(path, write):
+    """Write ``path`` atomically: ``write(f)`` fills a binary temporary
+    file in the same folder, which is flushed to disk and then renamed
+    over ``path`` (``os.replace``); a kill or an error during the write
+    leaves the previous file as it was.  Checkpoints, the overkill cache
+    and VTU collections are written this way.  Returns ``path``."""
+    path = os.fspath(path)
+    d = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(dir=d, prefix=".tmp-",
+                               suffix=os.path.splitext(path)[1])
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+    return path

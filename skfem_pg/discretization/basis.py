@@ -36,6 +36,7 @@ assembly; the batched hot paths (:func:`skfem_pg.assemble`,
 from __future__ import annotations
 
 import copy
+import inspect
 import sys
 import warnings
 
@@ -125,13 +126,14 @@ def _refuse_fe_arguments(families, unknown):
         if known:
             raise TypeError("FamilyBasis() got {}={!r}: {}".format(
                 known[0], unknown[known[0]], _FE_KEYWORDS[known[0]]))
+        options = [name for name, par in inspect.signature(
+            FamilyBasis.__init__).parameters.items()
+            if par.kind is par.POSITIONAL_OR_KEYWORD
+            and name not in ("self", "particles")]
         raise TypeError(
             "FamilyBasis() got unexpected keyword argument(s) {}; its "
-            "options are families, shape, bond, vc, method, dim, "
-            "weight_exponent, vc_solver, area_vectors, vc_exclude, "
-            "test_shape, lme_mu, vc_boundary, vc_tolerance, distributed, "
-            "weights, family_quadrature".format(
-                ", ".join(map(repr, sorted(unknown)))))
+            "options are {}".format(", ".join(map(repr, sorted(unknown))),
+                                    ", ".join(options)))
 
 
 class FamilyBasis(AbstractBasis):

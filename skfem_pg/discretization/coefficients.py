@@ -129,12 +129,10 @@ def _search(mesh, x, k=12):
     far = np.flatnonzero(score.max(axis=1) < -INSIDE)
     if len(far) and ns > k:  # not among the nearest: look wider
         c2, s2 = scores(x[:, far], 4 * k)
-        cand = np.pad(cand, ((0, 0), (0, c2.shape[1] - cand.shape[1])),
-                      mode="edge")
-        score = np.pad(score, ((0, 0), (0, s2.shape[1] - score.shape[1])),
-                       mode="edge")
-        better = s2.max(axis=1) > score[far].max(axis=1)
-        cand[far[better]], score[far[better]] = c2[better], s2[better]
+        wide = c2.shape[1] - cand.shape[1]  # columns that never win
+        cand = np.pad(cand, ((0, 0), (0, wide)), mode="edge")
+        score = np.pad(score, ((0, 0), (0, wide)), constant_values=-np.inf)
+        cand[far], score[far] = c2, s2  # the wider search holds the nearer
     return parent[cand], score
 
 

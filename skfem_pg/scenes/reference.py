@@ -13,7 +13,6 @@ cache that cannot be written warns and still returns the reference.
 import hashlib
 import os
 import re
-import tempfile
 import time
 import warnings
 import zipfile
@@ -24,6 +23,7 @@ import skfem as fem
 from ..formulations.linear import linear_elasticity
 from .meshing import cook_membrane
 from .. import registry
+from ..io import atomic_write
 from .scene import centroid_tree, exact, inside
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
@@ -106,14 +106,7 @@ def _store(fn, **arrays):
     arrays = dict(arrays, checksum=_checksum(arrays), format=CACHE_FORMAT)
     try:
         os.makedirs(d, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp.npz")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, **arrays)
-            os.replace(tmp, fn)
-        finally:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
+        atomic_write(fn, lambda f: np.savez(f, **arrays))
     except OSError as err:
         warnings.warn("could not write the overkill reference cache {} "
                       "({}); the reference is used but not kept".format(

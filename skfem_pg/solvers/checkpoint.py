@@ -21,11 +21,11 @@ resumed after a crash and end where the uninterrupted run ends.
 import hashlib
 import json
 import os
-import tempfile
 import time
 import zipfile
 
 import numpy as np
+from ..io import atomic_write
 from ..naming import name_of
 from ..discretization.layout import is_family_basis
 
@@ -153,20 +153,7 @@ def save(path, model, x, load=1.0, kind=None, **state):
 def atomic_savez(path, **arrays):
     """``numpy.savez`` to ``path`` atomically: a temporary file in the
     same directory, flushed to disk, then ``os.replace``."""
-    path = _path(path)
-    d = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(dir=d, prefix=".checkpoint-",
-                               suffix=".tmp.npz")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez(fh, **arrays)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-    return path
+    return atomic_write(_path(path), lambda f: np.savez(f, **arrays))
 
 
 def load(path, model, state=False, kind=None, needs=()):

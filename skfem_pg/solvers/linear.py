@@ -223,8 +223,6 @@ class Factorization:
         if ordering not in ("pardiso", "rcm+mmd", "colamd"):
             raise ValueError("ordering must be 'auto', 'pardiso', 'rcm+mmd' "
                              "or 'colamd', got {!r}".format(ordering))
-        if ordering == "rcm+mmd" and np.any(self.A.diagonal() == 0.0):
-            ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
         self.ordering = ordering
         self._pardiso = self._superlu = None
         self._checked = False  # SuperLU's diagonal pivots not yet checked
@@ -234,6 +232,9 @@ class Factorization:
 
     def _factor(self, ordering, pivot=False):
         A = self.A
+        if ordering == "rcm+mmd" and np.any(A.diagonal() == 0.0):
+            ordering = "colamd"  # a saddle point: RCM + MMD fills in badly
+        self.ordering = ordering
         if ordering == "pardiso":
             import pypardiso
             from pypardiso.pardiso_wrapper import PyPardisoError
@@ -335,8 +336,7 @@ class Factorization:
                 self.free()
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", spl.MatrixRankWarning)
-                    self._factor("rcm+mmd")
-                self.ordering = "rcm+mmd"
+                    self._factor("rcm+mmd")  # COLAMD for a saddle point
         x = self._solve_superlu(b)
         if not self._checked:  # diagonal pivots: checked by the residual
             scale = np.abs(A).max() * max(np.abs(x).max(), 1e-300)
