@@ -149,6 +149,10 @@ SCRIPTS = [
      "scikit-fem's ex03, ex11, ex22 with the basis swapped: FE against "
      "the PG default and MQ on the same nodes, against overkills",
      "2 min", 120),
+    ("census", ["benchmarks/census.py"],
+     "68 wrong inputs, each in its own process: correct, named or bare "
+     "error, silent, hang, data loss (`--compare` before/after)",
+     "40 s", 40),
     ("stress_hole", ["benchmarks/stress_hole.py"],
      "particle stresses at a hole against T1/Q1 nodal averages: Kirsch's "
      "exact solution, an elliptic hole against a curved T2 overkill",

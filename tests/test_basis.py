@@ -208,3 +208,7 @@ def test_point_source_interpolator_and_project_speak_scikit_fem():
         b.project(lambda x: np.vstack([x[0], x[1]]))
     with pytest.raises(ValueError, match="vector basis"):
         pg.FamilyBasis(mesh, dim=2).point_source(x)
+    # points as rows (n, dim): NumPy's "truth value ... ambiguous" before
+    with pytest.raises(ValueError, match=r"\(dim, n\) = \(2, n\), got "
+                                         r"shape \(3, 2\); points as rows"):
+        b.probes(np.array([[0.5, 0.5], [0.2, 0.5], [0.1, 0.1]]))

@@ -174,8 +174,11 @@ def test_bar_bounces_off_a_rigid_wall(method):
 
 
 def test_explicit_step_above_the_limit_is_refused():
-    """A step 10 % above 2/omega_max grows without bound: the run stops
-    with DynamicsError instead of returning garbage."""
+    """A step 10 % above 2/omega_max grows without bound: it is refused
+    where it enters, with the stable step named (issue 47: a fixed step
+    far above it ran until an "inverted point"); the run whose energy
+    balance breaks stops with DynamicsError instead of returning
+    garbage."""
     L = 10.0
     basis = basis_of(bar(L), "PG")
     model = Hyperelastic(basis, ELASTIC)
@@ -183,11 +186,39 @@ def test_explicit_step_above_the_limit_is_refused():
     dt = stable_time_step(model, m, safety=1.0)
     assert np.isclose(dt, 2 / max_frequency(model, m, model.initial()))
     D = basis.get_dofs("left").flatten()
-    with pytest.raises(DynamicsError, match="energy balance error"):
+    with pytest.raises(ValueError, match=r"dt = .* is above the stable "
+                                         r"step 2/omega_max = "):
         central_difference(model, m, 400 * dt, D=D, dt=1.1 * dt,
                            u0=first_mode(basis, L), verbose=False)
+    with pytest.raises(DynamicsError, match="energy balance error"):
+        central_difference(model, m, 400 * dt, D=D, u0=first_mode(basis, L),
+                           verbose=False, safety=1.0, max_energy_error=1e-9)
     central_difference(model, m, 400 * dt, D=D, dt=0.99 * dt,
                        u0=first_mode(basis, L), verbose=False)
+
+
+def test_conditionally_stable_newmark_refuses_a_step_above_its_limit():
+    """Issue 47: Newmark with beta < gamma/2 (linear acceleration, beta =
+    1/6) is stable for omega_max dt <= 1/sqrt(gamma/2 - beta) = 3.46; at
+    3 x 2/omega_max it returned a run whose own energy record was 147 %
+    off, without a word.  Refused now where dt enters, with the limit
+    named; below the limit it runs with its energy balanced."""
+    L = 10.0
+    basis = basis_of(bar(L), "PG")
+    model = Hyperelastic(basis, ELASTIC)
+    m = lumped_mass(basis, RHO)
+    D = basis.get_dofs("left").flatten()
+    w = max_frequency(model, m, model.initial())
+    limit = np.sqrt(12.0) / w
+    u0 = first_mode(basis, L)
+    with pytest.raises(ValueError, match=r"above the stability limit .* "
+                                         r"beta = 0.1667 < gamma/2"):
+        newmark(model, m, 40 * limit, 1.05 * limit, D=D, u0=u0,
+                beta=1 / 6, verbose=False)
+    tr = newmark(model, m, 40 * limit, 0.95 * limit, D=D, u0=u0,
+                 beta=1 / 6, verbose=False)
+    assert np.abs(tr.series("relative_error")).max() < 1e-2
+    newmark(model, m, 4 * limit, 5 * limit, D=D, u0=u0, verbose=False)
 
 
 def test_explicit_refuses_global_mixed_fields():

@@ -325,7 +325,55 @@ def test_fe_quadrature_data_on_the_generic_path_is_named():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         with pytest.raises(ValueError, match="integrates at its family "
+                                             "members.*cell_values_at_"
                                              "members"):
             conduction_generic.assemble(basis, k=p0)
         with pytest.raises(ValueError, match="cell_values_at_members"):
             conduction_generic.assemble(basis, k=k_cells)
+
+
+def test_port_flux_on_the_basis_own_facet_basis():
+    """Issue 47 (scikit-fem's ex13): the current through a port of the
+    quarter annulus (u = 2θ/π, current 2 ln 2 / π).  ``basis.boundary``
+    is scikit-fem's ``CellBasis.boundary``: a facet basis of the
+    collocation mesh's linear element, which takes the particle vector
+    (a facet basis of another element refuses it in scikit-fem's own
+    ``interpolate``).  The facet flux of the linear trace is first order
+    (P1 on the same facets +3.7 / −3.5 %, PG +2.9 / −1.8 %); the reaction
+    at the port's dofs is the consistent one (P1 +0.13 %, PG −0.16 %)."""
+    from skfem.helpers import dot, grad
+    from skfem.models.poisson import laplace
+    polar = fem.MeshTri.init_tensor(np.linspace(1, 2, 11),
+                                    np.linspace(0, np.pi / 2, 32))
+    r, th = polar.p
+    mesh = fem.MeshTri(np.array([r * np.cos(th), r * np.sin(th)]),
+                       polar.t).with_boundaries(
+        {"ground": lambda x: np.abs(x[1]) < 1e-12,
+         "positive": lambda x: np.abs(x[0]) < 1e-12})
+    exact = 2 * np.log(2) / np.pi
+
+    @fem.Functional
+    def port_flux(w):
+        return dot(w.n, grad(w.u))
+
+    basis = pg.FamilyBasis(mesh)
+    A = pg.assemble(laplace, basis)
+    u = basis.zeros()
+    u[basis.get_dofs("positive")] = 1.0
+    u = fem.solve(*fem.condense(A, x=u, D=basis.get_dofs(
+        {"positive", "ground"})))
+    p1 = fem.FacetBasis(mesh, fem.ElementTriP1(),
+                        facets=mesh.boundaries["ground"])
+    for port, sign in (("positive", 1), ("ground", -1)):
+        fb = basis.boundary(mesh.boundaries[port])
+        current = sign * port_flux.assemble(fb, u=fb.interpolate(u))
+        reaction = sign * (A @ u)[basis.get_dofs(port).all()].sum()
+        assert abs(current / exact - 1) < 0.035
+        assert abs(reaction / exact - 1) < 0.003
+    fb = basis.boundary(mesh.boundaries["ground"])
+    assert np.isclose(port_flux.assemble(fb, u=fb.interpolate(u)),
+                      port_flux.assemble(p1, u=p1.interpolate(u)),
+                      rtol=1e-14)
+    with pytest.raises(NotImplementedError, match="vertices"):
+        pg.FamilyBasis(pg.Particles.from_mesh(mesh, kind="centroids")
+                       ).boundary()

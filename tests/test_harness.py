@@ -9,12 +9,16 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def _harness():
+def _load(name, *path):
     spec = importlib.util.spec_from_file_location(
-        "harness", os.path.join(ROOT, "demos", "harness.py"))
+        name, os.path.join(ROOT, *path))
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _harness():
+    return _load("harness", "demos", "harness.py")
 
 
 def test_time_to_target_waits_until_the_error_stays_there():
@@ -80,13 +84,9 @@ def _run_times():
     through ``benchmarks/harness.py``)."""
     sys.path.insert(0, os.path.join(ROOT, "benchmarks"))
     try:
-        spec = importlib.util.spec_from_file_location(
-            "run_times", os.path.join(ROOT, "benchmarks", "run_times.py"))
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
+        return _load("run_times", "benchmarks", "run_times.py")
     finally:
         sys.path.remove(os.path.join(ROOT, "benchmarks"))
-    return module
 
 
 def _section(path, name):
@@ -133,3 +133,28 @@ def test_pages_are_written_atomically(tmp_path):
     assert text.rstrip().endswith("tail")
     assert oct(page.stat().st_mode & 0o777) == "0o644"
     assert os.listdir(tmp_path) == ["page.md"]
+
+
+def test_the_census_classes_each_outcome():
+    """``benchmarks/census.py`` (issue 47): each input in its own process;
+    an error naming every token is named, another bare, a wrong answer
+    silent (or data loss where a file mattered), a time-out a hang — and
+    three of its own inputs are classed as the code now answers them."""
+    census = _load("census", "benchmarks", "census.py")
+    cls = {}
+    for name, code, names, ok, data in (
+            ("named", "raise ValueError('dt = 3 above the stable step')",
+             ["dt", "stable"], None, False),
+            ("bare", "raise KeyError('energy_T0')", ["dt"], None, False),
+            ("silent", "result = 0.9", ["x"], "result == 1.0", False),
+            ("data loss", "result = 0.5", ["x"], "result == 0.25", True),
+            ("correct", "result = 1.0", ["x"], "result == 1.0", False),
+            ("hang", "import time\ntime.sleep(30)", ["x"], None, False)):
+        c = census.case(name, "test", "own", code, names, ok, data)
+        cls[name] = census.run_case(c, None, 3.0 if name == "hang"
+                                    else 60.0)["cls"]
+    assert cls == {k: k for k in cls}
+    chosen = {c["id"]: c for c in census.CASES}
+    for id, want in (("save-wrong-length", "named"),
+                     ("factorization-dense", "correct")):
+        assert census.run_case(chosen[id], None, 120.0)["cls"] == want

@@ -510,6 +510,23 @@ def test_factorization_solves_many_right_hand_sides(ordering):
         f.free()
     with pytest.raises(ValueError, match="ordering"):
         Factorization(A, "umfpack")
+    # issue 47: a NaN in the matrix or the load was "a singular matrix —
+    # too few Dirichlet conditions", a dense array an AttributeError
+    bad = A.copy()
+    bad.data[7] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite entries \(first: row "
+                                         r"\d+, column \d+ = nan\)"):
+        Factorization(bad, ordering)
+    f = Factorization(A.toarray(), ordering)
+    with pytest.raises(ValueError, match="right-hand side has 1 non-finite"):
+        f.solve(np.r_[np.nan, np.ones(n - 1)])
+    with pytest.raises(ValueError, match="must have 80 rows"):
+        f.solve(np.ones(n + 1))
+    B = rng.standard_normal((n, 2))
+    assert np.abs(A @ f.solve(B) - B).max() <= 1e-10 * np.abs(B).max()
+    f.free()
+    with pytest.raises(ValueError, match="square matrix"):
+        Factorization(sp.csr_matrix(np.ones((2, 3))), ordering)
 
 
 def test_solver_docstring_examples_run():

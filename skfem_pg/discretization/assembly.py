@@ -244,9 +244,11 @@ def check_coefficients(basis, kwargs):
                     "members, ({}, {}) points.  Data from an FE basis' "
                     "quadrature cannot be used here: pass a callable of "
                     "the position and evaluate it in the form at w.x, a "
-                    "dof vector of this basis (length {}), or "
-                    "basis.interpolate(u) of this basis".format(
-                        k, shape[-2:], shape, nf, m, basis.N))
+                    "dof vector of this basis (length {}), "
+                    "basis.interpolate(u) of this basis, or for a value "
+                    "per cell (a P0 field) skfem_pg.discretization."
+                    "coefficients.cell_values_at_members(basis, values)"
+                    .format(k, shape[-2:], shape, nf, m, basis.N))
         elif isinstance(v, np.ndarray) and v.ndim == 1 \
                 and basis.mesh is not None \
                 and v.shape[0] == basis.mesh.nelements != basis.N:

@@ -614,8 +614,15 @@ class FamilyBasis(AbstractBasis):
         shape-function values between particles (:math:`N^{ki}(X^j) =
         \delta_{ij}`); this is the interpolation its loads and VTU output
         use."""
-        return self._collocation_basis("probes").probes(
-            np.asarray(x, dtype=float))
+        x = np.asarray(x, dtype=float)
+        d = self.particles.dim
+        if x.ndim != 2 or x.shape[0] != d:
+            raise ValueError(
+                "probes takes points x of shape (dim, n) = ({}, n), got "
+                "shape {}{}".format(d, x.shape, "; points as rows: pass x.T"
+                                    if x.ndim == 2 and x.shape[1] == d
+                                    else ""))
+        return self._collocation_basis("probes").probes(x)
 
     def point_source(self, x):
         """The right-hand side of a unit point source at ``x``
@@ -703,6 +710,32 @@ class FamilyBasis(AbstractBasis):
         e1, _ = linear_elements(self.mesh)
         from skfem.visuals.matplotlib import plot
         return plot(fem.Basis(self.mesh, e1), z, **kwargs)
+
+    def boundary(self, facets=None, intorder=None):
+        """A scikit-fem ``FacetBasis`` on ``facets`` (default: the boundary)
+        that interpolates this basis' dof vectors, as scikit-fem's
+        ``CellBasis.boundary``: the particle values are the nodal values
+        of the collocation mesh's linear element ``basis.elem``, so
+        ``fb.interpolate(u)`` is their trace (P1/Q1 between particles) for
+        boundary functionals such as a port's flux (scikit-fem's ex13).
+        The reaction ``(K @ u)[basis.get_dofs(port)]`` is the consistent
+        flux of a Dirichlet port, usually the more accurate one.
+
+        >>> import numpy as np, skfem as fem, skfem_pg as pg
+        >>> mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 5),) * 2)
+        >>> basis = pg.FamilyBasis(mesh)
+        >>> fb = basis.boundary(mesh.facets_satisfying(lambda x: x[0] == 1))
+        >>> float(fem.Functional(lambda w: w.u).assemble(
+        ...     fb, u=fb.interpolate(basis.project(lambda x: x[1]))))
+        0.5
+        """
+        if self.mesh is None:
+            raise NotImplementedError(
+                "boundary needs particles collocated from a mesh's "
+                "vertices; {} particles have no facets".format(
+                    self.particles.kind))
+        return fem.FacetBasis(self.mesh, self.elem, facets=facets,
+                              intorder=intorder)
 
     def with_element(self, elem):
         """Not available: a family basis has no other element to swap in

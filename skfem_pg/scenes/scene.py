@@ -445,7 +445,8 @@ class Scene:
                     i = point_index(particles.x, x, "particle")
                 except ValueError as err:
                     raise ValueError("probe {} at {} is not a particle ({})"
-                                     .format(label, tuple(x), err)) from None
+                                     .format(label, tuple(map(float, x)),
+                                             err)) from None
                 out[label] = u.reshape(-1, d)[i].copy()
             else:
                 xi = inside(basis.mesh, x[:, None])

@@ -376,6 +376,20 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         step = estimate()
         F_est = _gradients(state)
         times["estimate"] += time.perf_counter() - t1
+    elif resume is None:
+        # a fixed step above 2/omega_max grows without bound and died
+        # later as an "inverted point" (issue 47); the Ritz value is a
+        # lower bound of omega_max, so no stable step is refused
+        t1 = time.perf_counter()
+        limit = stable_time_step(model, m, u, free, 1.0, exchange=ex)
+        times["estimate"] += time.perf_counter() - t1
+        if step > limit:
+            raise ValueError(
+                "dt = {:.4g} is above the stable step 2/omega_max = {:.4g} "
+                "of central differences at the start: the run would "
+                "diverge.  Give dt <= {:.4g} or leave dt=None (the "
+                "estimated step times safety = {})".format(
+                    step, limit, limit, safety))
     base = step  # the estimate's step, before the configuration scaling
     if output_every is None:
         output_every = max(1, int(round(t_end / step / 20)))

@@ -195,6 +195,25 @@ def direct(A, b, ordering="auto", definite=None, **kwargs):
 _PARDISO_SOLVERS = {}
 
 
+def _checked_matrix(A):
+    """``A`` as CSR, refused with a named error if it is not square or has
+    non-finite entries (which SuperLU and PARDISO report as a singular
+    matrix)."""
+    A = sp.csr_matrix(A) if not sp.issparse(A) else A.tocsr()
+    if A.ndim != 2 or A.shape[0] != A.shape[1]:
+        raise ValueError("a direct solve needs a square matrix, got shape "
+                         "{}".format(A.shape))
+    bad = np.flatnonzero(~np.isfinite(A.data))
+    if bad.size:
+        row = int(np.searchsorted(A.indptr, bad[0], side="right") - 1)
+        raise ValueError(
+            "the matrix has {} non-finite entries (first: row {}, column "
+            "{} = {}): a NaN or inf in the assembled system (a material "
+            "parameter, a coefficient or a state), not a singular one"
+            .format(bad.size, row, int(A.indices[bad[0]]), A.data[bad[0]]))
+    return A
+
+
 class Factorization:
     """A sparse direct factorization of ``A``, kept for many right-hand
     sides (:func:`direct` is one of them; Newton's method keeps one for
@@ -216,7 +235,7 @@ class Factorization:
     """
 
     def __init__(self, A, ordering="auto", definite=None):
-        self.A = A.tocsr()
+        self.A = _checked_matrix(A)
         self.definite = definite  # False: skip PARDISO's Cholesky
         if ordering == "auto":
             ordering = "pardiso" if pardiso_available() else "rcm+mmd"
@@ -327,6 +346,18 @@ class Factorization:
         """``A⁻¹ b`` by the kept factors, checked."""
         b = np.asarray(b, dtype=float)
         A = self.A
+        if b.ndim not in (1, 2) or b.shape[0] != A.shape[0]:
+            raise ValueError("the right-hand side must have {} rows (shape "
+                             "({},) or ({}, k)) for a {} x {} matrix, got "
+                             "shape {}".format(A.shape[0], A.shape[0],
+                                               A.shape[0], *A.shape,
+                                               b.shape))
+        bad = np.flatnonzero(~np.isfinite(b.ravel()))
+        if bad.size:
+            raise ValueError(
+                "the right-hand side has {} non-finite entries (first: "
+                "entry {} = {}): the load, not the matrix".format(
+                    bad.size, bad[0], b.ravel()[bad[0]]))
         if self._pardiso is not None:
             x = self._solve_pardiso(b)
             try:

@@ -82,6 +82,36 @@ class _Inertial:
         return K + sp.diags(diag)
 
 
+def check_conditional_stability(model, m, x, free, dt, beta, gamma,
+                                 displacement_only=True):
+    r"""Refuses a step above Newmark's stability limit when ``beta <
+    gamma/2`` (conditionally stable: linear acceleration, Fox–Goodwin):
+    :math:`\omega_{max}\,\Delta t \le \Omega_{crit} = 1/\sqrt{\gamma/2 -
+    \beta}` (undamped; Hughes 1987, 9.1).  Above it the run grows without
+    bound and its own energy record shows errors above 100 % without a
+    word (issue 47).  ``omega_max`` is the Lanczos Ritz value at the
+    start, a lower bound: no stable step is refused."""
+    if beta >= gamma / 2:
+        return  # unconditionally stable
+    if not displacement_only:
+        raise ValueError(
+            "beta = {:.4g} < gamma/2 = {:.4g} is only conditionally stable "
+            "and the step limit can be checked for displacement-only "
+            "models only: use beta >= gamma/2 (default 1/4)".format(
+                beta, gamma / 2))
+    from .explicit import max_frequency
+    limit = 1.0 / np.sqrt(gamma / 2 - beta) / max_frequency(model, m, x,
+                                                            free)
+    if dt > limit:
+        raise ValueError(
+            "dt = {:.4g} is above the stability limit {:.4g} of Newmark's "
+            "method with beta = {:.4g} < gamma/2 (conditionally stable: "
+            "omega_max dt <= 1/sqrt(gamma/2 - beta) = {:.3g}): use dt <= "
+            "{:.4g} or beta >= gamma/2 (default 1/4, unconditionally "
+            "stable)".format(dt, limit, beta, 1 / np.sqrt(gamma / 2 - beta),
+                             limit))
+
+
 def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
             f_ext: ArrayLike | Callable | None = None, D=None,
             u_D: ArrayLike | Callable | None = None,
@@ -161,6 +191,9 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
     free = free_mask(n_u, Dd)
     held = np.zeros(n_u, dtype=bool)
     times = dict.fromkeys(("assemble", "linear", "output", "contact"), 0.0)
+    if resume is None:
+        check_conditional_stability(model, m, x, free, dt, beta, gamma,
+                                    N == n_u)
     state = model.state(x)
     fi = np.asarray(model.internal_force(state), dtype=float)
     fe = f_of(0.0)
