@@ -149,6 +149,11 @@ SCRIPTS = [
      "scikit-fem's ex03, ex11, ex22 with the basis swapped: FE against "
      "the PG default and MQ on the same nodes, against overkills",
      "2 min", 120),
+    ("second_order", ["benchmarks/second_order.py"],
+     "why the package's U2 loses its rates: the manufactured solution's "
+     "L2/H1 rates of the U2 variants, a per-particle Petrov VC2 "
+     "candidate, T1/Q1, T2/Q2; the adjoint consistency by ring",
+     "2 min", 120),
     ("census", ["benchmarks/census.py"],
      "68 wrong inputs, each in its own process: correct, named or bare "
      "error, silent, hang, data loss (`--compare` before/after)",
