@@ -504,6 +504,48 @@ def blend_patch_and_modes(kind, distortion, n):
     return residual, int(np.sum(ev < 1e-10)), ev[3]
 
 
+def stencil(mesh):
+    """Non-zeros per row of the blend's matrix, per particle: ``i`` and
+    ``j`` couple where one cell's vertices' families hold both; and the
+    families' mean size."""
+    from skfem_pg.discretization.moment_quadrature import default_families
+    fam = default_families(pg.Particles.from_mesh(mesh))
+    mem, mask = fam.padded()
+    family = np.empty(mesh.nvertices, dtype=np.int64)
+    family[fam.masters] = np.arange(len(fam))
+    local = mem[family[mesh.t]]  # (vertices of a cell, cells, m)
+    held = mask[family[mesh.t]]
+    cells = np.broadcast_to(np.arange(mesh.nelements)[:, None],
+                            local.shape[1:])
+    A = sp.csr_matrix((np.ones(held.sum()), (
+        np.broadcast_to(cells, local.shape)[held], local[held])),
+        shape=(mesh.nelements, mesh.nvertices))
+    A.data[:] = 1.0
+    return (A.T @ A).nnz / mesh.nvertices, float(fam.sizes.mean())
+
+
+def stencil_table(sizes):
+    """The blend's couplings per particle against FE2's per node at the
+    same unknowns, 2-D and 3-D (regular grids of the unit square/cube)."""
+    from skfem.models.poisson import mass
+    rows = []
+    for name, mk, e2 in (
+            ("triangles", lambda n: fem.MeshTri.init_tensor(
+                *(np.linspace(0, 1, n + 1),) * 2), fem.ElementTriP2()),
+            ("tetrahedra", lambda n: fem.MeshTet.init_tensor(
+                *(np.linspace(0, 1, n + 1),) * 3), fem.ElementTetP2())):
+        for n in sizes:
+            nnz, size = stencil(mk(n))
+            b2 = fem.Basis(mk(n // 2), e2)
+            M = mass.assemble(b2)
+            rows.append([name, n, mk(n).nvertices, "{:.1f}".format(size),
+                         "{:.0f}".format(nnz),
+                         "{:.0f}".format(M.nnz / M.shape[0])])
+    return markdown_table(["cells", "n", "particles", "mean family",
+                           "blend: couplings / particle",
+                           "FE2 on n/2: couplings / node"], rows)
+
+
 def write(name, text):
     for page in RESULTS[:1]:
         print("updated", update_results(page, "second_order_" + name, text))
@@ -547,6 +589,14 @@ def main(sizes, quick=False):
                             "quadratic patch residual", "zero eigenvalues",
                             "next / largest"], checks)
     print(check)
+    couplings = stencil_table([4, 8] if quick else [8, 12])
+    print(couplings)
+    if not quick:
+        write("stencil", "`python benchmarks/second_order.py`: the "
+              "couplings per row of the blend (particles sharing a cell's "
+              "families; times the components for non-zeros) against "
+              "T2/O2 on n/2 x n/2 cells (the same unknowns).\n\n"
+              + couplings)
     if not quick:
         write("adjoint", "`python benchmarks/second_order.py`: T(z) = "
               "sum_i z_i tau_i by the particles' ring from the boundary "
