@@ -8,8 +8,9 @@ cells: T2 has about four times the unknowns).  Errors are relative: L2
 at the vertices with the lumped volumes (the same measure for every
 method), H1 with each method's own quadrature.
 
-Rows: the package's U2 variants by their Table 7.1 names and a candidate
-built here from the package's arrays (not part of the package):
+Rows: the package's U2 variants by their Table 7.1 names and two
+candidates built here from the package's arrays (not part of the
+package):
 
 * ``PG2 candidate`` — the moment-matched quadrature of the WTE2 fit
   (``family_quadrature="moments"``) as the trial basis, and test
@@ -34,9 +35,10 @@ built here from the package's arrays (not part of the package):
 Second part: the adjoint consistency functional ``T(z) = sum_i z_i tau_i``
 (``tau = K I(u) - f``, ``z`` smooth and zero on the boundary), split by the
 particles' ring from the boundary: its order bounds the L2 rate (Aubin-
-Nitsche).  Third: the candidate's quadratic patch test and its zero modes
-on a free body.  Tables into ``benchmarks/README.md`` (sections
-``second_order_*``).
+Nitsche).  Third: the candidates' quadratic patch tests and their zero
+modes on a free body.  Fourth: the blend's couplings per particle against
+T2/O2's per node at the same unknowns, on triangles and tetrahedra.
+Tables into ``benchmarks/README.md`` (sections ``second_order_*``).
 
     python benchmarks/second_order.py [--sizes 8 16 32] [--quick]
 """
