@@ -153,8 +153,8 @@ SCRIPTS = [
      "why the package's U2 loses its rates: the manufactured solution's "
      "L2/H1 rates of the U2 variants, a per-particle Petrov VC2 "
      "candidate and the conforming blend of the fits, T1/Q1, T2/Q2; the "
-     "adjoint consistency by ring; the stencils in 2-D and 3-D",
-     "4 min", 240),
+     "adjoint consistency by ring; the blend on tetrahedra against O2; "
+     "the stencils in 2-D and 3-D", "4 min", 240),
     ("census", ["benchmarks/census.py"],
      "68 wrong inputs, each in its own process: correct, named or bare "
      "error, silent, hang, data loss (`--compare` before/after)",

@@ -36,7 +36,8 @@ Second part: the adjoint consistency functional ``T(z) = sum_i z_i tau_i``
 (``tau = K I(u) - f``, ``z`` smooth and zero on the boundary), split by the
 particles' ring from the boundary: its order bounds the L2 rate (Aubin-
 Nitsche).  Third: the candidates' quadratic patch tests and their zero
-modes on a free body.  Fourth: the blend's couplings per particle against
+modes on a free body.  Fourth: the blend on tetrahedra against O2 with
+the same unknowns.  Fifth: the blend's couplings per particle against
 T2/O2's per node at the same unknowns, on triangles and tetrahedra.
 Tables into ``benchmarks/README.md`` (sections ``second_order_*``).
 
@@ -75,35 +76,71 @@ def node_set(n, kind, distortion):
     return m.to_meshtri() if kind == "tri" else m
 
 
-def _errors(mesh, u_vertices, h1):
+def _errors(mesh, u_vertices, h1, field=FIELD):
     V = pg.Particles.from_mesh(mesh).volumes
-    u_ex = FIELD(mesh.p).T
-    e = u_vertices.reshape(-1, 2) - u_ex
+    u_ex = field(mesh.p).T
+    e = u_vertices.reshape(u_ex.shape) - u_ex
     l2 = np.sqrt(np.sum(V * (e ** 2).sum(1)) / np.sum(V * (u_ex ** 2).sum(1)))
     return {"nodes": mesh.nvertices, "L2": float(l2), "H1": float(h1)}
 
 
-def fe(mesh, order):
-    """T1/Q1 (order 1) or T2/Q2 (order 2) on the node set's cells."""
-    tri = isinstance(mesh, fem.MeshTri)
-    e = {(1, True): fem.ElementTriP1(), (1, False): fem.ElementQuad1(),
-         (2, True): fem.ElementTriP2(), (2, False): fem.ElementQuad2()}[
-        order, tri]
+def fe(mesh, order, field=FIELD):
+    """T1/Q1 (order 1) or T2/Q2 (order 2) on the node set's cells; O2 on
+    tetrahedra."""
+    e = {(1, fem.MeshTri): fem.ElementTriP1(),
+         (1, fem.MeshQuad): fem.ElementQuad1(),
+         (2, fem.MeshTri): fem.ElementTriP2(),
+         (2, fem.MeshQuad): fem.ElementQuad2(),
+         (2, fem.MeshTet): fem.ElementTetP2()}[order, type(mesh)]
+    d = mesh.dim()
     t0 = time.perf_counter()
-    basis = fem.Basis(mesh, fem.ElementVector(e), intorder=6)
+    basis = fem.Basis(mesh, fem.ElementVector(e), intorder=6 if d == 2
+                      else 5)
     K = pg.assemble(linear_elasticity(LAM, MU), basis)
-    b = FIELD.body_force(LAM, MU)
+    b = field.body_force(LAM, MU)
     f = fem.LinearForm(lambda v, w: dot(b(w.x), v)).assemble(basis)
-    x = FIELD(basis.doflocs)[np.arange(basis.N) % 2, np.arange(basis.N)]
-    u = fem.solve(*fem.condense(K, f, x=x, D=basis.get_dofs()))
+    x = field(basis.doflocs)[np.arange(basis.N) % d, np.arange(basis.N)]
+    u = fem.solve(*fem.condense(K, f, x=x, D=basis.get_dofs()),
+                  solver=pg.solvers.direct)
     seconds = time.perf_counter() - t0
     uh = basis.interpolate(u)
-    g = FIELD.grad(basis.global_coordinates().value)
+    g = field.grad(basis.global_coordinates().value)
     h1 = np.sqrt(np.sum(basis.dx * ((uh.grad - g) ** 2).sum((0, 1)))
                  / np.sum(basis.dx * (g ** 2).sum((0, 1))))
-    out = _errors(mesh, u[basis.nodal_dofs].T.ravel(), h1)
-    out.update(dofs=basis.N, seconds=seconds)
+    out = _errors(mesh, u[basis.nodal_dofs].T.ravel(), h1, field)
+    out.update(dofs=basis.N, seconds=seconds, nnz=K.nnz / basis.N)
     return out
+
+
+def tetrahedra_table(sizes):
+    """The blend on the unit cube of tetrahedra (``PlaneWaves(3)``, full
+    Dirichlet) against O2 with the same unknowns (n/2 cells per side)."""
+    field = PlaneWaves(3)
+    rows, series = [], []
+    for n in sizes:
+        cube = fem.MeshTet.init_tensor(*(np.linspace(0, 1, n + 1),) * 3)
+        half = fem.MeshTet.init_tensor(*(np.linspace(0, 1, n // 2 + 1),)
+                                       * 3)
+        b, o = blend(cube, field=field), fe(half, 2, field)
+        series.append(b)
+        rows.append([n, b["dofs"], "{:.2e}".format(b["L2"]),
+                     "{:.2e}".format(o["L2"]),
+                     "{:.2f}".format(b["L2"] / o["L2"]),
+                     "{:.2e}".format(b["H1"]), "{:.2e}".format(o["H1"]),
+                     "{:.2f}".format(b["H1"] / o["H1"]),
+                     "{:.0f} / {:.0f}".format(b["nnz"], o["nnz"]),
+                     "{:.1f} / {:.1f}".format(b["seconds"], o["seconds"])])
+        print(" | ".join(map(str, rows[-1])), flush=True)
+    h = [1.0 / np.cbrt(r["nodes"]) for r in series]
+    text = markdown_table(["n", "unknowns", "L2 blend", "L2 O2", "ratio",
+                           "H1 blend", "H1 O2", "ratio",
+                           "nnz / row, blend / O2",
+                           "seconds, blend / O2"], rows)
+    if len(series) > 1:
+        text += "\n\nRates of the blend: L2 {:.2f}, H1 {:.2f}.".format(
+            rates(h, [r["L2"] for r in series])[0],
+            rates(h, [r["H1"] for r in series])[0])
+    return text
 
 
 def surface_moments(mesh):
@@ -222,20 +259,24 @@ def blend_fits(mesh):
     return mem, mask, Wp @ Minv, geo.h, family
 
 
-def blended(mesh, base, cells, fits):
+def blended(mesh, base, cells, fits, part=slice(None)):
     """Gradients ``(el, L, q, d)`` and values ``(el, L, q)`` of the blended
     shape functions at the points of ``base`` (a cell or facet basis of
-    the mesh's linear element on ``cells``), their particles ``(el, L)``
-    and mask, and the points ``(d, el, q)``."""
+    the mesh's linear element on ``cells``; the elements ``part`` of
+    them), their particles ``(el, L)`` and mask, and the points ``(d, el,
+    q)``."""
     from skfem_pg.discretization.shape.quadratic import (
         taylor2_basis, taylor2_derivatives)
     mem, mask, c, hk, family = fits
-    X = base.global_coordinates().value
-    nv, (ne, nq), m = mesh.t.shape[0], X.shape[1:], mem.shape[1]
-    G = np.zeros((ne, nv, m, nq, 2))
+    X = base.global_coordinates().value[:, part]
+    cells = cells[part]
+    d, nv, (ne, nq), m = mesh.dim(), mesh.t.shape[0], X.shape[1:], \
+        mem.shape[1]
+    G = np.zeros((ne, nv, m, nq, d))
     V = np.zeros((ne, nv, m, nq))
     for a in range(nv):
         hat = base.basis[a][0]
+        hat_value, hat_grad = hat.value[part], hat.grad[:, part]
         verts = mesh.t[a, cells]
         k = family[verts]
         Y = (np.moveaxis(X, 0, -1) - mesh.p.T[verts][:, None, :]) \
@@ -247,71 +288,95 @@ def blended(mesh, base, cells, fits):
         grad[:, 0] = -grad[:, 1:].sum(1)
         val *= mask[k][..., None]
         grad *= mask[k][..., None, None]
-        G[:, a] = hat.value[:, None, :, None] * grad \
-            + np.moveaxis(hat.grad, 0, -1)[:, None] * val[..., None]
-        V[:, a] = hat.value[:, None, :] * val
-    return (G.reshape(ne, nv * m, nq, 2), V.reshape(ne, nv * m, nq),
+        G[:, a] = hat_value[:, None, :, None] * grad \
+            + np.moveaxis(hat_grad, 0, -1)[:, None] * val[..., None]
+        V[:, a] = hat_value[:, None, :] * val
+    return (G.reshape(ne, nv * m, nq, d), V.reshape(ne, nv * m, nq),
             mem[family[mesh.t[:, cells]].T].reshape(ne, -1),
             mask[family[mesh.t[:, cells]].T].reshape(ne, -1), X)
 
 
-def _elasticity():
-    I = np.eye(2)
+def _elasticity(d=2):
+    I = np.eye(d)
     return LAM * np.einsum("ab,cd->abcd", I, I) + MU * (
         np.einsum("ac,bd->abcd", I, I) + np.einsum("ad,bc->abcd", I, I))
 
 
 def _scatter(Ke, dofs, mask, N):
-    """``(el, L, 2, L, 2)`` element matrices into a sparse ``N x N``
+    """``(el, L, d, L, d)`` element matrices into a sparse ``N x N``
     (repeated particles of an element add up)."""
-    rows = 2 * dofs[:, :, None, None, None] + np.arange(2)[:, None, None]
-    cols = 2 * dofs[:, None, None, :, None] + np.arange(2)
+    d = Ke.shape[2]
+    rows = d * dofs[:, :, None, None, None] + np.arange(d)[:, None, None]
+    cols = d * dofs[:, None, None, :, None] + np.arange(d)
     keep = mask[:, :, None, None, None] & mask[:, None, None, :, None]
     rows, cols, keep = np.broadcast_arrays(rows, cols, keep)
     return sp.csr_matrix((Ke[keep], (rows[keep], cols[keep])), shape=(N, N))
 
 
 def _gather(fe, dofs, mask, N):
+    d = fe.shape[-1]
     f = np.zeros(N)
-    np.add.at(f, (2 * dofs[..., None] + np.arange(2))[mask].ravel(),
+    np.add.at(f, (d * dofs[..., None] + np.arange(d))[mask].ravel(),
               fe[mask].ravel())
     return f
 
 
-def blend(mesh, beta=20.0):
-    """The ``PG2 blend`` row (module docstring)."""
+def _facet_size(mesh, facets):
+    """Edge lengths (2-D), square roots of twice the areas (3-D)."""
+    v = mesh.p[:, mesh.facets[:, facets]]
+    if mesh.dim() == 2:
+        return np.linalg.norm(v[:, 1] - v[:, 0], axis=0)
+    return np.sqrt(np.linalg.norm(np.cross((v[:, 1] - v[:, 0]).T,
+                                           (v[:, 2] - v[:, 0]).T), axis=1))
+
+
+def blend(mesh, beta=20.0, field=FIELD, chunk=400):
+    """The ``PG2 blend`` row (module docstring), in chunks of ``chunk``
+    elements."""
     t0 = time.perf_counter()
+    d = mesh.dim()
     fits = blend_fits(mesh)
     e1 = pg.particles.linear_elements(mesh)[0]
-    N, C = 2 * mesh.nvertices, _elasticity()
+    N, C = d * mesh.nvertices, _elasticity(d)
+    K, f, sq, sq_ex = sp.csr_matrix((N, N)), np.zeros(N), 0.0, 0.0
     cb = fem.Basis(mesh, e1, intorder=4)
-    G, V, dofs, mask, X = blended(mesh, cb, np.arange(mesh.nelements), fits)
-    K = _scatter(np.einsum("cq,ciqB,pBrD,cjqD->cipjr", cb.dx, G, C, G,
-                           optimize=True), dofs, mask, N)
-    f = _gather(np.einsum("cq,ciq,pcq->cip", cb.dx, V,
-                          FIELD.body_force(LAM, MU)(X)), dofs, mask, N)
+    cells = np.arange(mesh.nelements)
+    parts = [slice(i, i + chunk) for i in range(0, len(cells), chunk)]
+    for part in parts:
+        G, V, dofs, mask, X = blended(mesh, cb, cells, fits, part)
+        w = cb.dx[part]
+        K = K + _scatter(np.einsum("cq,ciqB,pBrD,cjqD->cipjr", w, G, C, G,
+                                   optimize=True), dofs, mask, N)
+        f += _gather(np.einsum("cq,ciq,pcq->cip", w, V,
+                               field.body_force(LAM, MU)(X)), dofs, mask, N)
     # symmetric Nitsche on the whole (Dirichlet) boundary
     fb = fem.FacetBasis(mesh, e1, intorder=6)
-    Gf, Vf, df, mf, Xf = blended(mesh, fb, fb.tind, fits)
-    hf = np.linalg.norm(np.diff(mesh.p[:, mesh.facets[:, fb.find]],
-                                axis=1)[:, 0], axis=0)
-    pen = fb.dx * (beta * (LAM + 2 * MU) / hf)[:, None]
-    T = np.einsum("aBrD,ejqD,Beq->ejqar", C, Gf, fb.normals, optimize=True)
-    Kc = -np.einsum("eq,eiq,ejqpr->eipjr", fb.dx, Vf, T, optimize=True)
-    Kp = np.einsum("eq,eiq,ejq->eij", pen, Vf, Vf)[:, :, None, :, None] \
-        * np.eye(2)[:, None, :]
-    K = K + _scatter(Kc + Kc.transpose(0, 3, 4, 1, 2) + Kp, df, mf, N)
-    g = FIELD(Xf)
-    f = f + _gather(-np.einsum("eq,ejqar,aeq->ejr", fb.dx, T, g)
-                    + np.einsum("eq,ejq,peq->ejp", pen, Vf, g), df, mf, N)
+    for part in [slice(i, i + chunk) for i in range(0, len(fb.tind), chunk)]:
+        Gf, Vf, df, mf, Xf = blended(mesh, fb, fb.tind, fits, part)
+        w = fb.dx[part]
+        pen = w * (beta * (LAM + 2 * MU)
+                   / _facet_size(mesh, fb.find[part]))[:, None]
+        T = np.einsum("aBrD,ejqD,Beq->ejqar", C, Gf, fb.normals[:, part],
+                      optimize=True)
+        Kc = -np.einsum("eq,eiq,ejqpr->eipjr", w, Vf, T, optimize=True)
+        Kp = np.einsum("eq,eiq,ejq->eij", pen, Vf, Vf)[:, :, None, :,
+                                                       None] \
+            * np.eye(d)[:, None, :]
+        K = K + _scatter(Kc + Kc.transpose(0, 3, 4, 1, 2) + Kp, df, mf, N)
+        g = field(Xf)
+        f += _gather(-np.einsum("eq,ejqar,aeq->ejr", w, T, g)
+                     + np.einsum("eq,ejq,peq->ejp", pen, Vf, g), df, mf, N)
     u = pg.solvers.direct(K, f)
     seconds = time.perf_counter() - t0
-    U = u.reshape(-1, 2)[dofs] * mask[..., None]
-    gu = np.einsum("ciqB,cip->cqpB", G, U)
-    ge = np.moveaxis(FIELD.grad(X), (0, 1), (2, 3))
-    wq = cb.dx[..., None, None]
-    h1 = np.sqrt(np.sum(wq * (gu - ge) ** 2) / np.sum(wq * ge ** 2))
-    out = _errors(mesh, u, h1)
+    for part in parts:
+        G, V, dofs, mask, X = blended(mesh, cb, cells, fits, part)
+        gu = np.einsum("ciqB,cip->cqpB", G,
+                       u.reshape(-1, d)[dofs] * mask[..., None])
+        ge = np.moveaxis(field.grad(X), (0, 1), (2, 3))
+        wq = cb.dx[part][..., None, None]
+        sq += np.sum(wq * (gu - ge) ** 2)
+        sq_ex += np.sum(wq * ge ** 2)
+    out = _errors(mesh, u, np.sqrt(sq / sq_ex), field)
     out.update(dofs=N, seconds=seconds, nnz=K.nnz / N)
     return out
 
@@ -591,6 +656,14 @@ def main(sizes, quick=False):
                             "quadratic patch residual", "zero eigenvalues",
                             "next / largest"], checks)
     print(check)
+    cube = tetrahedra_table([4] if quick else [4, 6, 8])
+    print(cube)
+    if not quick:
+        write("tetrahedra", "`python benchmarks/second_order.py`: the "
+              "blend on the unit cube of tetrahedra (n cells per side, "
+              "PlaneWaves(3), full Dirichlet by Nitsche) against O2 on "
+              "n/2 cells per side (the same unknowns); the blend's seconds "
+              "are this script's unoptimized assembly.\n\n" + cube)
     couplings = stencil_table([4, 8] if quick else [8, 12])
     print(couplings)
     if not quick:
