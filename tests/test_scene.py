@@ -155,7 +155,7 @@ def test_cache_keys_see_every_parameter_to_the_last_bit():
     6-digit repr shared one file between A = 792 and 792.00008)."""
     from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
                                     JohnsonCookHardening)
-    from skfem_pg.scenes.scene import exact
+    from skfem_pg.keys import exact
     mesh = fem.MeshQuad.init_tensor(np.linspace(0, 2, 5),
                                     np.linspace(0, 1, 3)).with_boundaries(
         {"left": lambda x: x[0] == 0, "right": lambda x: x[0] == 2})
@@ -177,6 +177,15 @@ def test_cache_keys_see_every_parameter_to_the_last_bit():
                {"tol": np.nextafter(1e-9, 1.0)}):
         assert key(**kw) != base, kw
     assert key(sy=0.45) == key(sy=0.45) != key(sy=np.nextafter(0.45, 1.0))
+    # a law's private caches (state of its last evaluation) are not
+    # parameters: a used law keys like a fresh one
+    used = J2Plasticity(80.0, 160.0, 0.45, H=0.13)
+    used._spectral = np.ones((4, 3))
+    assert exact(used) == exact(J2Plasticity(80.0, 160.0, 0.45, H=0.13))
+    import doctest
+    from skfem_pg import keys
+    result = doctest.testmod(keys)
+    assert result.attempted > 0 and result.failed == 0
 
 
 @pytest.mark.parametrize("scheme", ["PG", "Q1"])

@@ -24,7 +24,8 @@ from ..formulations.linear import linear_elasticity
 from .meshing import cook_membrane
 from .. import registry
 from ..io import atomic_write
-from .scene import centroid_tree, exact, inside
+from .scene import centroid_tree, inside
+from ..keys import exact
 
 QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 
@@ -33,8 +34,9 @@ QUADRATIC = {"T1": "T2", "Q1": "Q2", "O1": "O2", "H1": "H2"}
 #: of quadratic elements constrain their facet dofs too; 4: the key holds
 #: the callable loads' values, the load steps and the solve keywords, the
 #: file its format and a checksum of its content; 5: nested laws and
-#: solve keywords in the key by their exact values, not their repr)
-CACHE_FORMAT = 5
+#: solve keywords in the key by their exact values, not their repr; 6:
+#: :func:`skfem_pg.keys.exact`, without the laws' private caches)
+CACHE_FORMAT = 6
 
 
 def cache_dir():

@@ -48,6 +48,7 @@ from ..discretization.loads import (call_user, fe_traction,
 from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
 from ..formulations.updated_lagrange import UpdatedLagrange
+from ..keys import exact
 from ..naming import fe_method, formulation_of, frame_of, parse
 from ..solvers import newton
 from ..solvers.result import Result
@@ -470,59 +471,6 @@ def _scheme(scheme, basis_kwargs):
                              method, ", ".join(registry.fe_names()),
                              err)) from None
     return "PG", formulation_of(method), {**kw, **basis_kwargs}
-
-
-def exact(v, depth=0):
-    """A reproducible description of a value for cache keys, exact to the
-    bit: floats by their hex form, arrays entry by entry, containers
-    recursively, functions by :func:`_callable_key` and any other object
-    (a material and the hardening and damage laws it holds) by its type
-    and its attributes, recursively (an object's ``repr`` rounds: 6
-    digits in the laws' — two laws with A = 792 and 792.00008 shared a
-    cached reference)."""
-    if isinstance(v, (bool, np.bool_)):
-        return bool(v)
-    if isinstance(v, (float, np.floating)):
-        return float(v).hex()
-    if isinstance(v, (int, np.integer)):
-        return int(v)
-    if isinstance(v, (str, type(None))):
-        return v
-    if isinstance(v, np.ndarray):
-        return [exact(a, depth + 1) for a in v.ravel().tolist()] \
-            + [v.shape]
-    if isinstance(v, dict):
-        return sorted((str(k), exact(a, depth + 1)) for k, a in v.items())
-    if isinstance(v, (list, tuple)):
-        return [exact(a, depth + 1) for a in v]
-    if callable(v) and not hasattr(v, "__dict__") or \
-            hasattr(v, "__code__"):
-        return _callable_key(v)
-    if hasattr(v, "__dict__") and depth < 8:
-        return (type(v).__module__, type(v).__qualname__,
-                exact(vars(v), depth + 1))
-    return repr(v)
-
-
-def _callable_key(f):
-    """A reproducible description of a function for cache keys: module,
-    name, byte code, constants, defaults and closure values (no memory
-    addresses)."""
-    code = getattr(f, "__code__", None)
-    if code is None:
-        return repr(type(f))
-    def value(c):
-        if callable(c):
-            return _callable_key(c)
-        if isinstance(c, np.ndarray):
-            return (c.shape, hashlib.sha1(np.ascontiguousarray(c)
-                                          .tobytes()).hexdigest())
-        return repr(c)
-    cells = [value(c.cell_contents) for c in (f.__closure__ or ())]
-    return (getattr(f, "__module__", ""), getattr(f, "__qualname__", ""),
-            hashlib.sha1(code.co_code).hexdigest(),
-            repr(code.co_consts), repr(code.co_names),
-            [value(c) for c in (f.__defaults__ or ())], cells)
 
 
 def centroid_tree(mesh):

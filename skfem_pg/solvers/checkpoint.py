@@ -18,7 +18,6 @@ resumed after a crash and end where the uninterrupted run ends.
   finite load factor (in [0, 1] for a static run) or time.
 * ``path`` may be given with or without its ``.npz`` suffix.
 """
-import hashlib
 import json
 import os
 import time
@@ -26,12 +25,14 @@ import zipfile
 
 import numpy as np
 from ..io import atomic_write
+from ..keys import digest, exact
 from ..naming import name_of
 from ..discretization.layout import is_family_basis
 
 #: bump when the stored content changes meaning (3: the mesh's cells in
-#: the fingerprint, the driver kind)
-FORMAT = 3
+#: the fingerprint, the driver kind; 4: the material by
+#: :func:`skfem_pg.keys.exact`)
+FORMAT = 4
 
 #: the drivers that write checkpoints: ``"static"`` (:func:`~skfem_pg.
 #: solvers.newton`, ``load`` a load factor), ``"newmark"`` and
@@ -46,25 +47,6 @@ RUNS = {"static": "a static run (newton)", "newmark": "a Newmark run",
 def _path(path):
     path = os.fspath(path)
     return path if path.endswith(".npz") else path + ".npz"
-
-
-def _digest(a):
-    a = np.ascontiguousarray(np.asarray(a, dtype=float))
-    return "{} {}".format(a.shape, hashlib.sha1(a.tobytes()).hexdigest()[:16])
-
-
-def _describe(value):
-    if isinstance(value, np.ndarray):
-        return _digest(value) if value.size > 8 else value.tolist()
-    if isinstance(value, (float, np.floating)):
-        return float(value).hex()
-    if isinstance(value, (int, str, bool, type(None), np.integer)):
-        return value if not isinstance(value, np.integer) else int(value)
-    if hasattr(value, "__dict__"):
-        return {"type": type(value).__qualname__,
-                **{k: _describe(v) for k, v in sorted(vars(value).items())
-                   if not k.startswith("_")}}
-    return repr(value)
 
 
 def fingerprint(model):
@@ -85,9 +67,9 @@ def fingerprint(model):
     else:
         kind = type(getattr(basis, "elem", basis)).__name__
     return {"formulation": type(model).__qualname__,
-            "material": json.dumps(_describe(material), sort_keys=True),
+            "material": repr(exact(material)),
             "basis": kind,
-            "positions": _digest(basis.doflocs),
+            "positions": digest(basis.doflocs),
             "cells": _cells(basis),
             "unknowns": str(getattr(model, "N", basis.N))}
 
@@ -98,8 +80,7 @@ def _cells(basis):
     t = getattr(mesh, "t", None)
     if t is None:
         return "none"
-    t = np.ascontiguousarray(np.asarray(t, dtype=np.int64))
-    return "{} {}".format(t.shape, hashlib.sha1(t.tobytes()).hexdigest()[:16])
+    return digest(t)
 
 
 def save(path, model, x, load=1.0, kind=None, **state):
