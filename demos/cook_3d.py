@@ -20,15 +20,16 @@ about 0.3 %).
 Methods (``--methods``) on gmsh tetrahedra of mesh sizes ``--sizes``: O1
 and O2 (what an FE user picks for bending), VC PBG Unl with the kNN recipe
 (the default on tetrahedra) and with the thesis' mesh families, and
-BCPPG Unl (not run by default); H1P0 on n x n x n/4 hex grids with interior
-nodes distorted by +-0.3h (``--hex``; tetrahedra have no mean-dilatation
-element here).  Prints errors, wall time (preprocess / assemble / solve),
+BCPPG Unl and PG2, the blended quadratic basis (not run by default);
+H1P0 on n x n x n/4 hex grids with interior nodes distorted by +-0.3h
+(``--hex``; tetrahedra have no mean-dilatation element here).  Prints
+errors, wall time (preprocess / assemble / solve),
 each method's time to 1 % and 0.3 %, the PG/O1 deviation and time ratios
 of Fig. 7.21; writes out/cook_3d.png (error against nodes and against wall
 time) and a VTU with von Mises stress.
 
     python demos/cook_3d.py [--sizes 3.5 2.5 2 1.6 1.3] [--hex 8 12 16 24]
-        [--methods O1 O2 "VC PBG Unl kNN" "VC PBG Unl" "BCPPG Unl"]
+        [--methods O1 O2 "VC PBG Unl kNN" "VC PBG Unl" "BCPPG Unl" PG2]
         [--reference 16 24]
 """
 import os
@@ -55,7 +56,9 @@ METHODS = {"O1": {"scheme": "O1"},
            "VC PBG Unl kNN": {"scheme": "PG"},
            # the thesis' recipe: mesh families, volume weights
            "VC PBG Unl": {"scheme": "PG", "families": "mesh"},
-           "BCPPG Unl": {"scheme": "PG", "method": "PPG1", "vc": None}}
+           "BCPPG Unl": {"scheme": "PG", "method": "PPG1", "vc": None},
+           # second order on the vertices (skfem_pg.discretization.blend)
+           "PG2": {"scheme": "PG2"}}
 #: run unless --methods says otherwise
 DEFAULT_METHODS = ("O1", "O2", "VC PBG Unl kNN", "VC PBG Unl")
 #: the accuracies whose wall time the demo reports
@@ -64,7 +67,7 @@ TARGETS = (0.01, 0.003)
 #: the finer node sets (a scene computes only what it needs)
 SETTLED = 1.0 / 3.0
 STYLES = {"O1": "k--o", "O2": "k:^", "H1P0": "k-s", "VC PBG Unl": "C0-D",
-          "VC PBG Unl kNN": "C2-v", "BCPPG Unl": "C1-s"}
+          "VC PBG Unl kNN": "C2-v", "BCPPG Unl": "C1-s", "PG2": "C3-P"}
 
 
 def cook3d(n, nz, distortion=0.0, seed=0):

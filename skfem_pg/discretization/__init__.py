@@ -22,6 +22,8 @@ systems.
                            stages one builder composes into a basis
 ``basis``                  :class:`FamilyBasis`, the container of the built
                            arrays behind scikit-fem's basis interface
+``blend``                  :class:`BlendBasis` (PG2): the families' quadratic
+                           fits blended by the mesh's hat functions
 ``assembly``, ``forms``    batched assembly; the fast-path decorators
 ``loads``                  tractions, stress and body loads on FE and PG bases
 ``coefficients``           piecewise (per-cell) coefficients at the members
@@ -31,10 +33,12 @@ from .particles import Particles
 from .families import Families
 from .builder import BasisSpec
 from .basis import FamilyBasis
+from .blend import BlendBasis
 from .assembly import assemble, block_pattern
 from .forms import BilinearForm, LinearForm
 from .loads import traction, stress_load, body_force
 
-__all__ = ["Particles", "Families", "BasisSpec", "FamilyBasis", "assemble",
+__all__ = ["Particles", "Families", "BasisSpec", "FamilyBasis", "BlendBasis",
+           "assemble",
            "block_pattern", "BilinearForm", "LinearForm", "traction",
            "stress_load", "body_force"]

@@ -162,7 +162,8 @@ class _CellView:
 
 def supports(basis):
     """Whether :func:`assemble` has a batched path for ``basis``."""
-    return isinstance(basis, FamilyBasis) or (
+    return isinstance(basis, FamilyBasis) or hasattr(
+        basis, "batched_view") or (
         isinstance(basis, fem.CellBasis)
         and not isinstance(basis.elem, fem.ElementComposite))
 
@@ -180,6 +181,8 @@ def _generic(form, *bases, **kwargs):
 def batched_view(basis):
     if not supports(basis):
         return None
+    if hasattr(basis, "batched_view"):  # e.g. the blended PG2 basis
+        return basis.batched_view()
     return (_FamilyView if isinstance(basis, FamilyBasis)
             else _CellView)(basis)
 

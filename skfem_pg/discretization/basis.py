@@ -244,6 +244,14 @@ class FamilyBasis(AbstractBasis):
         0.03–0.4 times T1's / Q1's error on the same nodes in 2-D, on
         3-D tetrahedra 0.1 times O1's from about 500 nodes
         (``benchmarks/README.md``, "2-D recipes").
+    order
+        1 (default): the thesis' PG, built from the options above.  2:
+        the blended quadratic basis ``PG2``
+        (:class:`~skfem_pg.discretization.blend.BlendBasis`: the
+        families' WTE2 fits blended by the mesh's hat functions; its
+        elements are the mesh cells), which takes ``dim``, ``families``
+        and ``intorder`` only; ``FamilyBasis(mesh, dim=2, order=2)``
+        returns that basis.
     vc_tolerance
         Largest accepted constraint residual after the VC correction,
         relative to :math:`h^{d-1}` (default 1e-8: the patch test holds
@@ -294,6 +302,27 @@ class FamilyBasis(AbstractBasis):
 
     """
 
+    def __new__(cls, particles=None, *args, order: int = 1, **kwargs):
+        # order=2: the blended quadratic basis, another kind of element
+        # (a mesh cell over its vertices' families); __init__ is skipped
+        if order == 2 and cls is FamilyBasis:
+            from .blend import BlendBasis
+            allowed = {"dim", "families", "intorder"}
+            other = sorted(set(kwargs) - allowed)
+            if args or other:
+                raise TypeError(
+                    "FamilyBasis(..., order=2) is the blended quadratic "
+                    "basis (PG2, skfem_pg.discretization.blend.BlendBasis): "
+                    "it takes dim=, families= and intorder= only, got {}"
+                    .format(", ".join(other) if other else
+                            "positional options"))
+            return BlendBasis(particles, **kwargs)
+        if order not in (1, 2):
+            raise ValueError("order must be 1 (the thesis' PG, the options "
+                             "below) or 2 (the blended quadratic basis "
+                             "PG2), got {!r}".format(order))
+        return super().__new__(cls)
+
     @kernel
     def __init__(self, particles: Particles | fem.Mesh,
                  families: str | Families | None = None,
@@ -308,7 +337,8 @@ class FamilyBasis(AbstractBasis):
                  vc_boundary: str = "min-norm",
                  vc_tolerance: float | None = 1e-8, distributed=None,
                  weights: str = "auto",
-                 family_quadrature: str = "members", **unknown) -> None:
+                 family_quadrature: str = "members", order: int = 1,
+                 **unknown) -> None:
         _refuse_fe_arguments(families, unknown)
         particles = _as_particles(particles)
         spec = BasisSpec.resolve(

@@ -103,6 +103,20 @@ def _traction_form(t, nc, what, origin=0.0):
     return fem.LinearForm(load)
 
 
+def _blend_traction(basis, facets, t):
+    r""":func:`traction` on the blended quadratic basis (PG2): the
+    consistent :math:`\int_\Gamma \psi_i t` with its own shape
+    functions."""
+    from .assembly import assemble
+    fb = basis.boundary(facets)
+    what = "the traction t(x)"
+    if callable(t):
+        warn_if_zero(call_user(t, fb.global_coordinates(), what), what)
+    else:
+        t = _constant_of(t, basis.ncomp, "traction t")
+    return assemble(_traction_form(t, basis.ncomp, what), fb)
+
+
 def _facet_basis(basis, facets, what):
     p = basis.particles
     if p.kind != "vertices":
@@ -123,6 +137,8 @@ def traction(basis: AbstractBasis, facets,
     an array of shape ``(dim, nfacets, nqp)``.  Returns a length-``N``
     vector.
     """
+    if hasattr(basis, "boundary") and hasattr(basis, "fits"):
+        return _blend_traction(basis, facets, t)
     if not is_family_basis(basis):
         return fe_traction(basis, facets, t)
     fb = _facet_basis(basis, facets, "traction")

@@ -35,6 +35,8 @@ What a driver asks of a model is :class:`~.protocol.Model`
 ``crack_aware``        :class:`CrackAware`, :class:`CrackAwareU1SIG`: Unl
                        and U1SIG whose families stop at failed cells
                        (beyond the thesis' 8.1)
+``nitsche``            :class:`WeakDirichlet`: Dirichlet conditions by
+                       Nitsche terms (the blended quadratic basis PG2)
 =====================  ====================================================
 """
 from .linear import linear_elasticity
@@ -51,6 +53,7 @@ from .history import History
 from .updated_lagrange import UpdatedLagrange
 from .bond_based import BondBased, segment_cut
 from .crack_aware import CrackAware, CrackAwareU1SIG
+from .nitsche import WeakDirichlet
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "material_tangent", "MeanDilatation", "MasterDilatation",
@@ -58,4 +61,4 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
            "History", "UpdatedLagrange", "Model", "BondBased",
-           "segment_cut", "CrackAware", "CrackAwareU1SIG"]
+           "segment_cut", "CrackAware", "CrackAwareU1SIG", "WeakDirichlet"]

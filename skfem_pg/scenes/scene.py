@@ -6,7 +6,10 @@ prescribed boundaries, dead-load tractions and probe points.
 ``scene.solve("VCBCPBG V5sn UnlP0")`` runs a formulation by its thesis name
 (Table 7.1, :mod:`skfem_pg.naming`) on a :class:`~skfem_pg.FamilyBasis`
 collocated from the mesh, ``scene.solve("PG", **basis_kwargs)`` the
-displacement formulation (VC PBG Unl by default) with basis options, and
+displacement formulation (VC PBG Unl by default) with basis options,
+``scene.solve("PG2")`` the blended quadratic basis on the same vertices
+(:mod:`skfem_pg.discretization.blend`; Dirichlet conditions by Nitsche
+terms, :class:`~skfem_pg.formulations.WeakDirichlet`), and
 ``scene.solve("FEM H1P0")`` (or ``"H1P0"``) scikit-fem elements on the same
 mesh:
 
@@ -43,10 +46,12 @@ import numpy as np
 import skfem as fem
 
 from ..discretization.basis import FamilyBasis
+from ..discretization.blend import BlendBasis
 from ..discretization.loads import (call_user, fe_traction,
                                     traction as pg_traction)
 from ..discretization.particles import Particles, linear_elements
 from ..formulations.by_name import model_for
+from ..formulations.nitsche import WeakDirichlet
 from ..formulations.updated_lagrange import UpdatedLagrange
 from ..keys import exact
 from ..naming import fe_method, formulation_of, frame_of, parse
@@ -310,6 +315,21 @@ class Scene:
                     vals[i], claims[who[i + 1]][2], vals[i + 1],
                     len(np.unique(dofs[clash]))))
 
+    def _weak_conditions(self):
+        """The clamped and prescribed boundaries as
+        :class:`~skfem_pg.formulations.WeakDirichlet` conditions."""
+        out = {name: None for name in self.clamped}
+        for name, how in self.prescribed.items():
+            if callable(how):
+                raise NotImplementedError(
+                    "PG2 imposes Dirichlet conditions by Nitsche terms that "
+                    "grow with the load factor; the prescribed f(x, t) on "
+                    "{!r} is not a value times the load factor: prescribe "
+                    "constant components ({{component: value}}) or use "
+                    "'PG'".format(name))
+            out[name] = dict(how)
+        return out
+
     def _fe_traction(self, basis, mesh, name, t):
         what = "the traction t(x) on {!r}" if callable(t) \
             else "traction on {!r}"
@@ -323,7 +343,9 @@ class Scene:
         """Solve with a thesis name (``"VCBCPBG V5sn UnlP0"``, ``"PBG
         IUnlP0"``, :mod:`skfem_pg.naming`; ``basis_kwargs`` override its
         basis options), ``"PG"`` (the displacement formulation;
-        ``basis_kwargs`` go to ``FamilyBasis``, e.g. ``method="PPG1"``) or
+        ``basis_kwargs`` go to ``FamilyBasis``, e.g. ``method="PPG1"``),
+        ``"PG2"`` (the blended quadratic basis; ``basis_kwargs``:
+        ``families``, ``intorder``) or
         an FE comparator of :func:`skfem_pg.registry.fe_names` (also as
         ``"FEM Q1P0"``);
         ``tol``: Newton's relative residual tolerance
@@ -357,6 +379,10 @@ class Scene:
     def _solve_distributed(self, scheme, comm, verbose, tangent, tol,
                            options, basis_kwargs):
         method, formulation, basis_kwargs = _scheme(scheme, basis_kwargs)
+        if method == "PG2":
+            raise NotImplementedError(
+                "PG2 on MPI: the blended quadratic basis is serial; the "
+                "distributed solver runs 'PG' and the thesis' names")
         if method != "PG":
             raise NotImplementedError(
                 "{} on MPI: FE methods run on scikit-fem's own distributed "
@@ -414,6 +440,19 @@ class Scene:
                 model = model_for(formulation, basis, self.material, tangent)
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
+        elif method == "PG2":
+            mesh = self.mesh if mesh is None else mesh
+            basis = BlendBasis(Particles.from_mesh(mesh), dim=self.dim,
+                               **basis_kwargs)
+            self._dirichlet(basis)  # the same checks of the conditions
+            model = WeakDirichlet(model_for("Unl", basis, self.material,
+                                            tangent),
+                                  self._weak_conditions())
+            f = sum((pg_traction(basis, n, t)
+                     for n, t in self.tractions.items()),
+                    model.load())
+            return basis, model, f, np.zeros(0, dtype=np.int64), None, \
+                time.perf_counter() - t0
         elif method in registry.fe_names():
             if basis_kwargs:
                 raise ValueError(
@@ -438,8 +477,9 @@ class Scene:
         a family basis (or given ``particles``), else interpolated."""
         out = {}
         d = self.dim
-        if particles is None and isinstance(basis, FamilyBasis):
-            particles = basis.particles
+        if particles is None and isinstance(basis, (FamilyBasis,
+                                                    BlendBasis)):
+            particles = basis.particles  # Kronecker at the particles
         for label, x in self.probes.items():
             if particles is not None:
                 try:
@@ -461,6 +501,8 @@ def _scheme(scheme, basis_kwargs):
     ``"PG"`` and thesis names, whose basis options are merged under the
     given ``basis_kwargs``)."""
     method = fe_method(scheme) or scheme
+    if method == "PG2":
+        return method, "Unl", basis_kwargs
     if method in registry.fe_names() or method == "PG":
         return method, "Unl", basis_kwargs
     try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"

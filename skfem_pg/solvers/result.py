@@ -62,7 +62,12 @@ class Result:
         ``boundary`` (or facets): the sum, per component, of the residual
         :meth:`residual` over the boundary's dofs (nodal and, for
         quadratic elements, facet and edge dofs).  Meaningful on a
-        boundary whose displacements are prescribed."""
+        boundary whose displacements are prescribed.  Conditions imposed
+        by Nitsche terms (PG2, :class:`~skfem_pg.formulations.
+        WeakDirichlet`) report their consistent flux instead."""
+        weak = getattr(self.model, "reaction", None)
+        if weak is not None:  # Dirichlet by Nitsche terms (PG2)
+            return weak(self.x, boundary)
         r = self.residual()
         dofs = self.basis.get_dofs(boundary)
         d = self.basis.mesh.dim()
