@@ -155,6 +155,11 @@ SCRIPTS = [
      "candidate and the conforming blend of the fits, T1/Q1, T2/Q2; the "
      "adjoint consistency by ring; the blend on tetrahedra against O2; "
      "the stencils in 2-D and 3-D", "4 min", 240),
+    ("pg2_vs_quadratic", ["benchmarks/pg2_vs_quadratic.py"],
+     "PG2 (the blended quadratic basis) against T1/T2, O1/O2, H1/H2 and "
+     "PG per unknown and per second: a curved cantilever and a plate "
+     "with a hole (2-D, linear), a neo-Hooke cantilever of hexahedra "
+     "(3-D)", "10 min", 600),
     ("census", ["benchmarks/census.py"],
      "68 wrong inputs, each in its own process: correct, named or bare "
      "error, silent, hang, data loss (`--compare` before/after)",

@@ -10,21 +10,25 @@ residual gains
 .. math::
 
     r(u; v) = -\int_{\Gamma_D} (P(F) N)\cdot M v
-        - \int_{\Gamma_D} (\mathbb A_0 : \nabla v\, N)\cdot M (u - g)
+        - \int_{\Gamma_D} (\mathbb A_s : \nabla v\, N)\cdot M (u - g)
         + \int_{\Gamma_D} \frac{\beta E}{h}\, M (u - g)\cdot v,
 
-with :math:`P` the first Piola-Kirchhoff stress, :math:`\mathbb A_0` the
-material's tangent in the undeformed state, :math:`E` its largest
-diagonal entry (:math:`\lambda + 2\mu` for an isotropic law), :math:`h`
+with :math:`P` the first Piola-Kirchhoff stress, :math:`E` the largest
+diagonal entry of the material's tangent :math:`\mathbb A_0` in the
+undeformed state (:math:`\lambda + 2\mu` for an isotropic law), :math:`h`
 the facet size and :math:`\beta` the penalty (default 20).  The first
 term makes the method consistent (the exact solution satisfies it), the
-second symmetric in the linear limit (Nitsche 1971; adjoint consistent
-for linear elasticity, whence the L2 rate), the third stable.  For a
-nonlinear material the second term uses :math:`\mathbb A_0`, so the
-tangent is not symmetric away from the undeformed state; the solvers
-detect that.  The terms linear in :math:`g` go into the load vector
-(:meth:`WeakDirichlet.load`): a prescribed value grows with the load
-factor like the loads.
+second symmetric (Nitsche 1971; adjoint consistent for linear
+elasticity, whence the L2 rate), the third stable.  Where every
+prescribed value is zero (clamps, rollers) :math:`\mathbb A_s` is the
+current tangent :math:`\mathbb A(F)`, and the tangent matrix drops the
+term :math:`\partial\mathbb A\,(u - g)` (the boundary's discretization
+error): it is symmetric, and the residual consistent.  With non-zero
+values :math:`\mathbb A_s = \mathbb A_0`, so that the terms linear in
+:math:`g` go into the load vector (:meth:`WeakDirichlet.load`; a
+prescribed value grows with the load factor like the loads): consistent,
+with an exact tangent that is not symmetric away from the undeformed
+state (the solvers detect that).
 """
 from __future__ import annotations
 
@@ -52,27 +56,27 @@ def _A0(material, d):
 
 @fem.LinearForm
 def _force(v, w):
-    # -(P N).M v - (A0 : grad v N).M u + beta E / h (M u).v
-    Pn = _traction(w.P, w.n)
-    A0v = np.einsum("ijkl,kl...->ij...", w.A0, v.grad)
-    return -dot(w.M * Pn, v) - dot(_traction(A0v, w.n), w.M * w.u) \
+    # -(P N).M v - (As : grad v N).M u + beta E / h (M u).v
+    Asv = np.einsum("ijkl...,kl...->ij...", w.As, v.grad)
+    return -dot(w.M * _traction(w.P, w.n), v) \
+        - dot(_traction(Asv, w.n), w.M * w.u) \
         + w.pen / w.h * dot(w.M * w.u, v)
 
 
 @fem.BilinearForm
 def _stiffness(du, v, w):
     Adu = np.einsum("ijkl...,kl...->ij...", w.A, du.grad)
-    A0v = np.einsum("ijkl,kl...->ij...", w.A0, v.grad)
+    Asv = np.einsum("ijkl...,kl...->ij...", w.As, v.grad)
     return -dot(w.M * _traction(Adu, w.n), v) \
-        - dot(_traction(A0v, w.n), w.M * du) \
+        - dot(_traction(Asv, w.n), w.M * du) \
         + w.pen / w.h * dot(w.M * du, v)
 
 
 @fem.LinearForm
 def _load(v, w):
     # the terms of g: -(A0 : grad v N).M g + beta E / h (M g).v
-    A0v = np.einsum("ijkl,kl...->ij...", w.A0, v.grad)
-    return -dot(_traction(A0v, w.n), w.M * w.g) \
+    Asv = np.einsum("ijkl...,kl...->ij...", w.As, v.grad)
+    return -dot(_traction(Asv, w.n), w.M * w.g) \
         + w.pen / w.h * dot(w.M * w.g, v)
 
 
@@ -90,10 +94,14 @@ class WeakDirichlet:
         ``{component: value}`` at load factor 1, ``None`` (every
         component zero, a clamp) or a callable ``g(x)`` of the facet
         points ``(d, nfacets, nqp)`` returning the displacement there
-        (every component; scaled by the load factor).
+        (every component; scaled by the load factor).  Facet index
+        arrays, which a dict cannot key, go as a list of ``(facets,
+        what)`` pairs.
     penalty
         :math:`\\beta` (default :data:`PENALTY`).
 
+    Notes
+    -----
     Newton's method then runs with no prescribed dofs and the load
     :meth:`load` added to the external forces.
 
@@ -134,7 +142,9 @@ class WeakDirichlet:
         self._E = float(max(self._A0[a, b, a, b] for a in range(d)
                             for b in range(d)))
         self.terms = []  # (name, facet basis, selector M (d, 1, 1), g)
-        for name, comps in conditions.items():
+        pairs = conditions.items() if isinstance(conditions, dict) \
+            else conditions
+        for name, comps in pairs:
             fb = basis.boundary(name)
             M, g = np.zeros((d, 1, 1)), np.zeros((d, 1, 1))
             if callable(comps):  # every component, a field g(x)
@@ -156,6 +166,9 @@ class WeakDirichlet:
                         .format(name, c, d))
                 M[int(c)], g[int(c)] = 1.0, float(val)
             self.terms.append((name, fb, M, g))
+        #: every prescribed value zero (clamps, rollers): the symmetrizing
+        #: term takes the current tangent, and so does the tangent matrix
+        self.homogeneous = not any(np.any(t[3]) for t in self.terms)
 
     # --- the wrapped model's protocol ------------------------------------
     def __getattr__(self, name):
@@ -164,8 +177,8 @@ class WeakDirichlet:
         return getattr(self.model, name)
 
     def energy(self, state):
-        r"""Not offered: the Nitsche terms with the reference tangent
-        :math:`\mathbb A_0` are no potential's derivative."""
+        r"""Not offered: the Nitsche terms are no potential's
+        derivative."""
         raise NotImplementedError(
             "the Nitsche terms of WeakDirichlet have no potential")
 
@@ -175,23 +188,28 @@ class WeakDirichlet:
         return s
 
     def _params(self, fb, M, u=None):
+        """The forms' coefficients on the facet basis ``fb``; with the
+        displacements ``u`` also ``u``, ``P`` and ``A`` there, and ``As``
+        the current tangent where the conditions are homogeneous."""
         d = fb.ncomp
-        p = dict(A0=self._A0, M=M, pen=self.penalty * self._E)
+        A0 = self._A0.reshape(self._A0.shape + (1, 1))
+        p = dict(As=A0, M=M, pen=self.penalty * self._E)
         if u is not None:
             U = fb.interpolate(u)
             F = U.grad + np.eye(d).reshape(d, d, 1, 1)
-            p.update(u=np.asarray(U), F=F)
+            material = self.model.material
+            p.update(u=np.asarray(U), P=material.stress(F),
+                     A=material.tangent(F))
+            if self.homogeneous:
+                p["As"] = p["A"]
         return p
-
-    def _material(self):
-        return self.model.material
 
     def boundary_force(self, state, term):
         """The Nitsche terms' residual of one condition (length ``N``)."""
         _, fb, M, _ = term
         p = self._params(fb, M, state["_weak_u"])
-        P = self._material().stress(p.pop("F"))
-        return assemble(_force, fb, P=P, **p)
+        p.pop("A")
+        return assemble(_force, fb, **p)
 
     def internal_force(self, state):
         r = self.model.internal_force(state)
@@ -203,9 +221,8 @@ class WeakDirichlet:
         K = self.model.tangent(state)
         for _, fb, M, _ in self.terms:
             p = self._params(fb, M, state["_weak_u"])
-            A = self._material().tangent(p.pop("F"))
-            p.pop("u")
-            Kb = assemble(_stiffness, fb, A=A, **p)
+            p.pop("u"), p.pop("P")
+            Kb = assemble(_stiffness, fb, **p)
             K = K + _pad_matrix(Kb, K.shape[0])
         return K
 
