@@ -204,7 +204,7 @@ def test_scene_pg2_on_a_3d_part():
     """Scene.solve("PG2") on a neo-Hooke cantilever of hexahedra: the
     clamp's reaction balances the load, and the tip deflection on 12 x 3
     x 3 cells is within 2 % of H2 on the same cells (five times the
-    unknowns; H2 there is -0.44 % from H2 on 32 x 8 x 8, PG2 -1.39 %), H1
+    unknowns; H2 there is -0.44 % from H2 on 32 x 8 x 8, PG2 -1.38 %), H1
     on the same nodes more than four times as far off (-7.8 %)."""
     sc = beam_scene(beam(12, 3))
     r = sc.solve("PG2", verbose=False)

@@ -85,8 +85,12 @@ class QuadraticFits(NamedTuple):
 
 
 #: a 3-D family whose equilibrated quadratic moment matrix has a larger
-#: condition number takes its next nearest particle (:func:`families_3d`)
-FIT_CONDITION = 1e2
+#: condition number takes its next nearest particle (:func:`families_3d`):
+#: 100 left 118 of the 615 surface families of the gmsh-meshed 3-D Cook
+#: plate (three layers thick) short of it after 64 more particles (mean
+#: family 33 members); 300 gives 17.5 members there at 6 % more tip
+#: error, 1000 15.9 members at 40 % more
+FIT_CONDITION = 3e2
 #: the nearest particles a 3-D family may take beyond its 1-ring
 MAX_ADDED = 64
 
@@ -114,11 +118,9 @@ def families_3d(particles: Particles, condition: float = FIT_CONDITION):
     time until it does not — or, if it never does within
     :data:`MAX_ADDED` of them, as many as gave the best-conditioned fit.
     Where the moment quadrature's rings double a surface family, this
-    keeps it near the 1-ring's size: on a 24 x 6 x 6 hexahedral
-    cantilever 613 instead of 1004 non-zeros per row, half the time, the
-    same tip deflection; on distorted tetrahedra 0.75 times the
-    non-zeros at 1.1 times the L2 error, on distorted hexahedra 0.53
-    times the error (``benchmarks/README.md``, PG2).  A family whose
+    keeps it near the 1-ring's size (``benchmarks/README.md``, "PG2 in
+    the package": fewer non-zeros and less time at about the same
+    accuracy on tetrahedra, less error on hexahedra).  A family whose
     members never determine a quadratic raises
     :class:`~skfem_pg.errors.FamilyError` naming the particle."""
     from scipy.spatial import cKDTree
