@@ -30,7 +30,8 @@ package):
   rule of degree 4 (exact for the energy of a quadratic field), the
   Dirichlet boundary by symmetric Nitsche terms (penalty 20 (lambda +
   2 mu) / h; the fits of interior particles do not vanish on the
-  boundary).
+  boundary): first a prototype here, now the package's ``PG2``
+  (:mod:`skfem_pg.discretization.blend`), which this row runs.
 
 Second part: the adjoint consistency functional ``T(z) = sum_i z_i tau_i``
 (``tau = K I(u) - f``, ``z`` smooth and zero on the boundary), split by the
@@ -54,8 +55,9 @@ import skfem_pg as pg
 from harness import demo_parser, markdown_table, update_results
 from skfem_pg.analysis.convergence import (PlaneWaves, rates,
                                            solve_manufactured)
-from skfem_pg.formulations import linear_elasticity
-from skfem_pg.materials import lame
+from skfem_pg.formulations import (Hyperelastic, WeakDirichlet,
+                                   linear_elasticity)
+from skfem_pg.materials import LinearElastic, lame
 from skfem_pg.naming import parse
 from recipes_2d import RESULTS
 
@@ -240,144 +242,29 @@ def candidate(mesh):
     return out
 
 
-def blend_fits(mesh):
-    """The WTE2 fits of the moment quadrature's default families:
-    ``(members, mask, coefficients (k, i, q), h_k, family of particle)``."""
-    from skfem_pg.discretization.moment_quadrature import default_families
-    from skfem_pg.discretization.shape.common import (FamilyGeometry,
-                                                      inverse_spd, weights)
-    from skfem_pg.discretization.shape.quadratic import taylor2_basis
-    p = pg.Particles.from_mesh(mesh)
-    fam = default_families(p)
-    mem, mask = fam.padded()
-    geo = FamilyGeometry(p.x, p.volumes, mem, mask)
-    W = weights((geo.D0 ** 2).sum(-1), 1, floor=True) * geo.V
-    Wp = W[..., None] * taylor2_basis(geo.D0)
-    Minv, _ = inverse_spd(np.swapaxes(Wp, -1, -2) @ taylor2_basis(geo.D0))
-    family = np.empty(p.n, dtype=np.int64)
-    family[fam.masters] = np.arange(len(fam))
-    return mem, mask, Wp @ Minv, geo.h, family
-
-
-def blended(mesh, base, cells, fits, part=slice(None)):
-    """Gradients ``(el, L, q, d)`` and values ``(el, L, q)`` of the blended
-    shape functions at the points of ``base`` (a cell or facet basis of
-    the mesh's linear element on ``cells``; the elements ``part`` of
-    them), their particles ``(el, L)`` and mask, and the points ``(d, el,
-    q)``."""
-    from skfem_pg.discretization.shape.quadratic import (
-        taylor2_basis, taylor2_derivatives)
-    mem, mask, c, hk, family = fits
-    X = base.global_coordinates().value[:, part]
-    cells = cells[part]
-    d, nv, (ne, nq), m = mesh.dim(), mesh.t.shape[0], X.shape[1:], \
-        mem.shape[1]
-    G = np.zeros((ne, nv, m, nq, d))
-    V = np.zeros((ne, nv, m, nq))
-    for a in range(nv):
-        hat = base.basis[a][0]
-        hat_value, hat_grad = hat.value[part], hat.grad[:, part]
-        verts = mesh.t[a, cells]
-        k = family[verts]
-        Y = (np.moveaxis(X, 0, -1) - mesh.p.T[verts][:, None, :]) \
-            / hk[k][:, None, None]
-        val = np.einsum("ciq,cxq->cix", c[k], taylor2_basis(Y))
-        grad = np.einsum("ciq,cxqd->cixd", c[k], taylor2_derivatives(Y)) \
-            / hk[k][:, None, None, None]
-        val[:, 0] = 1.0 - val[:, 1:].sum(1)  # the master's: 1 - the rest
-        grad[:, 0] = -grad[:, 1:].sum(1)
-        val *= mask[k][..., None]
-        grad *= mask[k][..., None, None]
-        G[:, a] = hat_value[:, None, :, None] * grad \
-            + np.moveaxis(hat_grad, 0, -1)[:, None] * val[..., None]
-        V[:, a] = hat_value[:, None, :] * val
-    return (G.reshape(ne, nv * m, nq, d), V.reshape(ne, nv * m, nq),
-            mem[family[mesh.t[:, cells]].T].reshape(ne, -1),
-            mask[family[mesh.t[:, cells]].T].reshape(ne, -1), X)
-
-
-def _elasticity(d=2):
-    I = np.eye(d)
-    return LAM * np.einsum("ab,cd->abcd", I, I) + MU * (
-        np.einsum("ac,bd->abcd", I, I) + np.einsum("ad,bc->abcd", I, I))
-
-
-def _scatter(Ke, dofs, mask, N):
-    """``(el, L, d, L, d)`` element matrices into a sparse ``N x N``
-    (repeated particles of an element add up)."""
-    d = Ke.shape[2]
-    rows = d * dofs[:, :, None, None, None] + np.arange(d)[:, None, None]
-    cols = d * dofs[:, None, None, :, None] + np.arange(d)
-    keep = mask[:, :, None, None, None] & mask[:, None, None, :, None]
-    rows, cols, keep = np.broadcast_arrays(rows, cols, keep)
-    return sp.csr_matrix((Ke[keep], (rows[keep], cols[keep])), shape=(N, N))
-
-
-def _gather(fe, dofs, mask, N):
-    d = fe.shape[-1]
-    f = np.zeros(N)
-    np.add.at(f, (d * dofs[..., None] + np.arange(d))[mask].ravel(),
-              fe[mask].ravel())
-    return f
-
-
-def _facet_size(mesh, facets):
-    """Edge lengths (2-D), square roots of twice the areas (3-D)."""
-    v = mesh.p[:, mesh.facets[:, facets]]
-    if mesh.dim() == 2:
-        return np.linalg.norm(v[:, 1] - v[:, 0], axis=0)
-    return np.sqrt(np.linalg.norm(np.cross((v[:, 1] - v[:, 0]).T,
-                                           (v[:, 2] - v[:, 0]).T), axis=1))
-
-
-def blend(mesh, beta=20.0, field=FIELD, chunk=400):
-    """The ``PG2 blend`` row (module docstring), in chunks of ``chunk``
-    elements."""
+def blend(mesh, beta=20.0, field=FIELD):
+    """The ``PG2 blend`` row: the package's PG2 (``FamilyBasis(mesh,
+    dim=d, order=2)``, Dirichlet by :class:`~skfem_pg.formulations.
+    WeakDirichlet` with penalty ``beta``), linear elastic."""
     t0 = time.perf_counter()
     d = mesh.dim()
-    fits = blend_fits(mesh)
-    e1 = pg.particles.linear_elements(mesh)[0]
-    N, C = d * mesh.nvertices, _elasticity(d)
-    K, f, sq, sq_ex = sp.csr_matrix((N, N)), np.zeros(N), 0.0, 0.0
-    cb = fem.Basis(mesh, e1, intorder=4)
-    cells = np.arange(mesh.nelements)
-    parts = [slice(i, i + chunk) for i in range(0, len(cells), chunk)]
-    for part in parts:
-        G, V, dofs, mask, X = blended(mesh, cb, cells, fits, part)
-        w = cb.dx[part]
-        K = K + _scatter(np.einsum("cq,ciqB,pBrD,cjqD->cipjr", w, G, C, G,
-                                   optimize=True), dofs, mask, N)
-        f += _gather(np.einsum("cq,ciq,pcq->cip", w, V,
-                               field.body_force(LAM, MU)(X)), dofs, mask, N)
-    # symmetric Nitsche on the whole (Dirichlet) boundary
-    fb = fem.FacetBasis(mesh, e1, intorder=6)
-    for part in [slice(i, i + chunk) for i in range(0, len(fb.tind), chunk)]:
-        Gf, Vf, df, mf, Xf = blended(mesh, fb, fb.tind, fits, part)
-        w = fb.dx[part]
-        pen = w * (beta * (LAM + 2 * MU)
-                   / _facet_size(mesh, fb.find[part]))[:, None]
-        T = np.einsum("aBrD,ejqD,Beq->ejqar", C, Gf, fb.normals[:, part],
-                      optimize=True)
-        Kc = -np.einsum("eq,eiq,ejqpr->eipjr", w, Vf, T, optimize=True)
-        Kp = np.einsum("eq,eiq,ejq->eij", pen, Vf, Vf)[:, :, None, :,
-                                                       None] \
-            * np.eye(d)[:, None, :]
-        K = K + _scatter(Kc + Kc.transpose(0, 3, 4, 1, 2) + Kp, df, mf, N)
-        g = field(Xf)
-        f += _gather(-np.einsum("eq,ejqar,aeq->ejr", w, T, g)
-                     + np.einsum("eq,ejq,peq->ejp", pen, Vf, g), df, mf, N)
-    u = pg.solvers.direct(K, f)
+    mesh = mesh.with_boundaries({"all": mesh.boundary_facets()})
+    basis = pg.FamilyBasis(mesh, dim=d, order=2)
+    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(LAM, MU)),
+                          {"all": field}, penalty=beta)
+    b = field.body_force(LAM, MU)
+    f = pg.assemble(fem.LinearForm(lambda v, w: dot(b(np.asarray(w.x)), v)),
+                    basis) + model.load()
+    s = model.state(np.zeros(basis.N))
+    K = model.tangent(s)
+    u = pg.solvers.direct(K, f - model.internal_force(s))
     seconds = time.perf_counter() - t0
-    for part in parts:
-        G, V, dofs, mask, X = blended(mesh, cb, cells, fits, part)
-        gu = np.einsum("ciqB,cip->cqpB", G,
-                       u.reshape(-1, d)[dofs] * mask[..., None])
-        ge = np.moveaxis(field.grad(X), (0, 1), (2, 3))
-        wq = cb.dx[part][..., None, None]
-        sq += np.sum(wq * (gu - ge) ** 2)
-        sq_ex += np.sum(wq * ge ** 2)
-    out = _errors(mesh, u, np.sqrt(sq / sq_ex), field)
-    out.update(dofs=N, seconds=seconds, nnz=K.nnz / N)
+    U = basis.interpolate(u)
+    ge = field.grad(np.asarray(basis.global_coordinates()))
+    h1 = np.sqrt(np.sum(basis.dx * ((U.grad - ge) ** 2).sum((0, 1)))
+                 / np.sum(basis.dx * (ge ** 2).sum((0, 1))))
+    out = _errors(mesh, u, h1, field)
+    out.update(dofs=basis.N, seconds=seconds, nnz=K.nnz / basis.N)
     return out
 
 
@@ -547,24 +434,20 @@ def blend_patch_and_modes(kind, distortion, n):
     """The blend's quadratic patch test with traction on the whole
     boundary (no Nitsche terms) and its free body's zero eigenvalues."""
     m = node_set(n, kind, distortion)
-    fits = blend_fits(m)
-    e1 = pg.particles.linear_elements(m)[0]
-    N, C, q = 2 * m.nvertices, _elasticity(), _Quadratic()
-    cb = fem.Basis(m, e1, intorder=4)
-    G, V, dofs, mask, X = blended(m, cb, np.arange(m.nelements), fits)
-    K = _scatter(np.einsum("cq,ciqB,pBrD,cjqD->cipjr", cb.dx, G, C, G,
-                           optimize=True), dofs, mask, N)
+    basis = pg.FamilyBasis(m, dim=2, order=2)
+    q = _Quadratic()
+    K = pg.assemble(linear_elasticity(LAM, MU), basis)
     b0 = -MU * np.einsum("abb->a", q.H) - (LAM + MU) * np.einsum("bab->a",
                                                                  q.H)
-    f = _gather(np.einsum("cq,ciq,p->cip", cb.dx, V, b0), dofs, mask, N)
-    fb = fem.FacetBasis(m, e1, intorder=6)
-    _, Vf, df, mf, Xf = blended(m, fb, fb.tind, fits)
-    g = q.grad(Xf)
-    eps = 0.5 * (g + np.swapaxes(g, 0, 1))
-    sig = 2 * MU * eps + LAM * (eps[0, 0] + eps[1, 1]) * np.eye(2)[
-        :, :, None, None]
-    t = np.einsum("abeq,beq->aeq", sig, fb.normals)
-    f = f + _gather(np.einsum("eq,ejq,peq->ejp", fb.dx, Vf, t), df, mf, N)
+    f = pg.assemble(fem.LinearForm(lambda v, w: dot(b0, v)), basis)
+
+    def traction(v, w):
+        g = q.grad(np.asarray(w.x))
+        eps = 0.5 * (g + np.swapaxes(g, 0, 1))
+        sig = 2 * MU * eps + LAM * (eps[0, 0] + eps[1, 1]) * np.eye(2)[
+            :, :, None, None]
+        return dot(np.einsum("abeq,beq->aeq", sig, w.n), v)
+    f = f + pg.assemble(fem.LinearForm(traction), basis.boundary())
     residual = np.abs(K @ q(m.p).T.ravel() - f).max() / np.abs(f).max()
     ev = np.sort(np.abs(np.linalg.eigvalsh(K.toarray())))
     ev = ev / ev.max()
@@ -572,23 +455,12 @@ def blend_patch_and_modes(kind, distortion, n):
 
 
 def stencil(mesh):
-    """Non-zeros per row of the blend's matrix, per particle: ``i`` and
-    ``j`` couple where one cell's vertices' families hold both; and the
-    families' mean size."""
-    from skfem_pg.discretization.moment_quadrature import default_families
-    fam = default_families(pg.Particles.from_mesh(mesh))
-    mem, mask = fam.padded()
-    family = np.empty(mesh.nvertices, dtype=np.int64)
-    family[fam.masters] = np.arange(len(fam))
-    local = mem[family[mesh.t]]  # (vertices of a cell, cells, m)
-    held = mask[family[mesh.t]]
-    cells = np.broadcast_to(np.arange(mesh.nelements)[:, None],
-                            local.shape[1:])
-    A = sp.csr_matrix((np.ones(held.sum()), (
-        np.broadcast_to(cells, local.shape)[held], local[held])),
-        shape=(mesh.nelements, mesh.nvertices))
-    A.data[:] = 1.0
-    return (A.T @ A).nnz / mesh.nvertices, float(fam.sizes.mean())
+    """Non-zeros per row of the blend's (scalar) matrix, per particle,
+    and its families' mean size."""
+    from skfem.models.poisson import mass
+    basis = pg.FamilyBasis(mesh, order=2)
+    return (pg.assemble(mass, basis).nnz / mesh.nvertices,
+            float(basis.fits.mask.sum(1).mean()))
 
 
 def stencil_table(sizes):
@@ -662,8 +534,9 @@ def main(sizes, quick=False):
         write("tetrahedra", "`python benchmarks/second_order.py`: the "
               "blend on the unit cube of tetrahedra (n cells per side, "
               "PlaneWaves(3), full Dirichlet by Nitsche) against O2 on "
-              "n/2 cells per side (the same unknowns); the blend's seconds "
-              "are this script's unoptimized assembly.\n\n" + cube)
+              "n/2 cells per side (the same unknowns); seconds: the "
+              "package's PG2 (basis, assembly, Nitsche terms, solve).\n\n"
+              + cube)
     couplings = stencil_table([4, 8] if quick else [8, 12])
     print(couplings)
     if not quick:
