@@ -137,7 +137,8 @@ def traction(basis: AbstractBasis, facets,
     an array of shape ``(dim, nfacets, nqp)``.  Returns a length-``N``
     vector.
     """
-    if hasattr(basis, "boundary") and hasattr(basis, "fits"):
+    from .blend import BlendBasis
+    if isinstance(basis, BlendBasis):
         return _blend_traction(basis, facets, t)
     if not is_family_basis(basis):
         return fe_traction(basis, facets, t)

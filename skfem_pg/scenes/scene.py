@@ -497,13 +497,11 @@ class Scene:
 
 def _scheme(scheme, basis_kwargs):
     """``(method, formulation, basis_kwargs)`` of a scene method name:
-    ``method`` is an FE comparator (:mod:`skfem_pg.registry`) or ``"PG"`` (for
-    ``"PG"`` and thesis names, whose basis options are merged under the
-    given ``basis_kwargs``)."""
+    ``method`` is an FE comparator (:mod:`skfem_pg.registry`), ``"PG2"``
+    or ``"PG"`` (for ``"PG"`` and thesis names, whose basis options are
+    merged under the given ``basis_kwargs``)."""
     method = fe_method(scheme) or scheme
-    if method == "PG2":
-        return method, "Unl", basis_kwargs
-    if method in registry.fe_names() or method == "PG":
+    if method in registry.fe_names() or method in ("PG", "PG2"):
         return method, "Unl", basis_kwargs
     try:  # a thesis name, e.g. "VCBCPBG V5sn Unl TL"
         kw, _ = parse(method)
