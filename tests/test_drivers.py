@@ -122,3 +122,25 @@ def test_dynamics_take_their_records(beam):
     k = central_difference(model, m, 0.05, f_ext=f, D=D, safety=0.5,
                            verbose=False)
     assert np.array_equal(e.x, k.x) and e.steps == k.steps > 1
+
+
+def test_drivers_name_what_a_model_lacks(beam):
+    """The drivers take a model by its protocol (issue 49: no
+    ``getattr(model, "N", basis.N)`` fallbacks): an object without ``N``
+    is refused where it enters, naming the driver and the member."""
+    model = Hyperelastic(beam[0], mat.NeoHooke(100.0, 40.0))
+
+    class NoN:
+        def __getattr__(self, name):
+            if name == "N":
+                raise AttributeError(name)
+            return getattr(model, name)
+    for run, name in ((lambda m: pg.solvers.newton(m), "newton"),
+                      (lambda m: pg.solvers.newmark(
+                          m, np.eye(1), 1.0, 1e-3), "newmark"),
+                      (lambda m: pg.solvers.central_difference(
+                          m, np.ones(1), 1.0), "central_difference"),
+                      (lambda m: pg.solvers.checkpoint.save(
+                          "x", m, np.zeros(3)), "checkpoint.save")):
+        with pytest.raises(TypeError, match=name + ".*lacks N"):
+            run(NoN())

@@ -132,8 +132,8 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
     ``x``, ``v``, ``a`` in the serial numbering on every rank; the
     energies are those of the whole body.
     """
-    n_u = getattr(model, "n_u", model.basis.N)
-    if getattr(model, "N", n_u) != n_u:
+    n_u = model.n_u
+    if model.N != n_u:
         raise NotImplementedError(
             "{} has global unknowns beyond the displacements: explicit "
             "steps on ranks take displacement models".format(

@@ -142,7 +142,7 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
             "reuse=True (modified Newton with kept factors) is serial: the "
             "distributed Newton refactorizes PETSc's preconditioner every "
             "iteration; drop reuse=")
-    if getattr(model, "N", None) != getattr(model, "n_u", model.N):
+    if model.N != model.n_u:
         raise NotImplementedError(
             "{} has global extra fields; the distributed Newton solves "
             "displacement models".format(type(model).__name__))

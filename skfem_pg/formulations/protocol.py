@@ -65,3 +65,19 @@ def check_model(model, token):
     raise TypeError("formulation {!r} built a {} without {} (the model "
                     "protocol, skfem_pg.formulations.protocol.Model)".format(
                         token, type(model).__name__, ", ".join(missing)))
+
+
+def require_model(model, driver):
+    """``model`` if it satisfies :class:`Model`, else ``TypeError`` naming
+    the ``driver`` and the members it lacks — where a driver takes a
+    model, so that the drivers use ``model.N`` and ``model.n_u`` without
+    probing."""
+    if isinstance(model, Model):
+        return model
+    missing = [m for m in ("basis", "n_u", "N", "initial", "state",
+                           "internal_force", "tangent", "min_J", "commit",
+                           "fields") if not hasattr(model, m)]
+    raise TypeError("{} takes a model (skfem_pg.formulations.protocol."
+                    "Model); {} lacks {}".format(
+                        driver, type(model).__name__, ", ".join(missing)))
+

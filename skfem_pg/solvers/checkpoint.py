@@ -28,6 +28,7 @@ from ..io import atomic_write
 from ..keys import digest, exact
 from ..naming import name_of
 from ..discretization.layout import is_family_basis
+from ..formulations.protocol import require_model
 
 #: bump when the stored content changes meaning (3: the mesh's cells in
 #: the fingerprint, the driver kind; 4: the material by
@@ -71,7 +72,7 @@ def fingerprint(model):
             "basis": kind,
             "positions": digest(basis.doflocs),
             "cells": _cells(basis),
-            "unknowns": str(getattr(model, "N", basis.N))}
+            "unknowns": str(model.N)}
 
 
 def _cells(basis):
@@ -96,7 +97,7 @@ def save(path, model, x, load=1.0, kind=None, **state):
     load factor outside [0, 1], a negative time, an unknown ``kind``."""
     path = _path(path)
     x = np.asarray(x, dtype=float)
-    n = getattr(model, "N", model.basis.N)
+    n = require_model(model, "checkpoint.save").N
     if x.shape != (n,):
         raise ValueError("checkpoint.save: x has shape {}, the model has {} "
                          "unknowns".format(x.shape, n))

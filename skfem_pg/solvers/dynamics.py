@@ -40,8 +40,7 @@ from .static import padded_vector
 def time_functions(model, f_ext, u_D):
     """``f(t)`` and ``u_D(t)`` as full-length vectors (one entry per
     unknown) from a vector, a callable of the time or ``None``."""
-    N = getattr(model, "N", model.basis.N)
-    n_u = getattr(model, "n_u", N)
+    N, n_u = model.N, model.n_u
 
     def wrap(v, what):
         if callable(v):

@@ -43,7 +43,7 @@ import time
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model
+from ..formulations.protocol import Model, require_model
 from ..dofs import as_dofs
 from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
@@ -320,8 +320,9 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
     safety, estimate_every, output_every = (c.safety, c.estimate_every,
                                             c.output_every)
     max_energy_error, verbose = c.max_energy_error, c.verbose
-    n_u = getattr(model, "n_u", model.basis.N)
-    if getattr(model, "N", n_u) != n_u:
+    model = require_model(model, "central_difference")
+    n_u = model.n_u
+    if model.N != n_u:
         raise ValueError(
             "{} has global unknowns beyond the displacements ({} of {}): "
             "explicit steps would need a global solve (6.2.3); integrate "

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model
+from ..formulations.protocol import Model, require_model
 from ..dofs import as_dofs, check_sliding
 from .contact import hold_initial
 from .checkpoint import Every
@@ -166,9 +166,8 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
         data (``dt``, Newton ``iterations``, ``cuts``) per output, the
         seconds of assembly, linear solves and output.
     """
-    basis = model.basis
-    N = getattr(model, "N", basis.N)
-    n_u = getattr(model, "n_u", N)
+    model = require_model(model, "newmark")
+    basis, N, n_u = model.basis, model.N, model.n_u
     c = NewmarkControls.of(controls, **kw)
     beta, gamma, dt_min, verbose = c.beta, c.gamma, c.dt_min, c.verbose
     m = check_run(n_u, N, m, t_end, dt, u0, v0, dt_required=True)

@@ -21,7 +21,7 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model
+from ..formulations.protocol import Model, require_model
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
@@ -162,9 +162,8 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     """
     opts = NewtonControls.of(controls, **kw)
     check_controls(load0=load0)
-    basis = model.basis
-    N = getattr(model, "N", basis.N)
-    n_u = getattr(model, "n_u", N)
+    model = require_model(model, "newton")
+    basis, N, n_u = model.basis, model.N, model.n_u
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
     I = np.setdiff1d(np.arange(N), Dd)
