@@ -390,6 +390,7 @@ class FamilyBasis(AbstractBasis):
         self._master_gradients = arrays.master_gradients
         self.timings, self.vc_report = arrays.timings, arrays.vc_report
         self._G, self._G_groups = arrays.G, arrays.G_groups
+        self._Gt_groups = self._values_groups = None  # built when asked
         self.test = None
         report = self.vc_report
         self.area_correction = None if report is None \
@@ -539,7 +540,7 @@ class FamilyBasis(AbstractBasis):
         form (an internal force), ``(nf_b, m·d, m)``: rows ``(j, b)``,
         columns the nodes ``i``; cached (a copy of ``G``), so a time step
         does not transpose ``G`` again."""
-        if getattr(self, "_Gt_groups", None) is None:
+        if self._Gt_groups is None:
             self._Gt_groups = [
                 np.ascontiguousarray(G.transpose(0, 1, 3, 2)).reshape(
                     G.shape[0], -1, G.shape[2])
@@ -552,7 +553,7 @@ class FamilyBasis(AbstractBasis):
         the quadrature points (values :math:`\delta_{ij}`)."""
         if self.values is None:
             return None
-        if getattr(self, "_values_groups", None) is None:
+        if self._values_groups is None:
             self._values_groups = [
                 np.ascontiguousarray(self.values[g.families, :g.m, :g.m])
                 for g in self.layout]
