@@ -32,7 +32,7 @@ import skfem as fem
 
 from ..discretization.layout import is_family_basis
 from ..solvers import explicit as serial
-from ..solvers.checkpoint import Every, atomic_savez, _path
+from ..solvers.checkpoint import Every, atomic_savez, npz_path
 from ..solvers.dynamics import Trajectory
 from ..solvers.mass import lumped_mass as serial_lumped_mass, row_sums
 from .halo import HaloExchange
@@ -97,7 +97,7 @@ class RankCheckpoints(Every):
 def resume_piece(path, part):
     """The piece of this rank named by the manifest ``path`` of
     :class:`RankCheckpoints`."""
-    path = _path(path)
+    path = npz_path(path)
     try:
         with np.load(path) as f:
             ranks, step = int(f["ranks"]), int(f["step"])

@@ -45,7 +45,9 @@ RUNS = {"static": "a static run (newton)", "newmark": "a Newmark run",
         "explicit": "an explicit run (central_difference)"}
 
 
-def _path(path):
+def npz_path(path):
+    """``path`` as the file a checkpoint is written to: ``.npz`` appended
+    unless it ends so (what ``np.savez`` would write)."""
     path = os.fspath(path)
     return path if path.endswith(".npz") else path + ".npz"
 
@@ -95,7 +97,7 @@ def save(path, model, x, load=1.0, kind=None, **state):
     Raises ``ValueError`` for ``x`` of another length than the model's
     unknowns or with non-finite entries, a non-finite ``load``, a static
     load factor outside [0, 1], a negative time, an unknown ``kind``."""
-    path = _path(path)
+    path = npz_path(path)
     x = np.asarray(x, dtype=float)
     n = require_model(model, "checkpoint.save").N
     if x.shape != (n,):
@@ -135,7 +137,7 @@ def save(path, model, x, load=1.0, kind=None, **state):
 def atomic_savez(path, **arrays):
     """``numpy.savez`` to ``path`` atomically: a temporary file in the
     same directory, flushed to disk, then ``os.replace``."""
-    return atomic_write(_path(path), lambda f: np.savez(f, **arrays))
+    return atomic_write(npz_path(path), lambda f: np.savez(f, **arrays))
 
 
 def load(path, model, state=False, kind=None, needs=()):
@@ -147,7 +149,7 @@ def load(path, model, state=False, kind=None, needs=()):
     do an unreadable file or one that is no checkpoint (naming its path),
     a checkpoint written by another ``kind`` of run than the one given
     (:data:`KINDS`), and one without the state entries ``needs``."""
-    path = _path(path)
+    path = npz_path(path)
     try:
         with np.load(path) as f:
             data = {k: f[k] for k in f.files}
@@ -231,7 +233,7 @@ class Every:
                                         and seconds > 0):
             raise ValueError("seconds must be a positive number, got {!r}"
                              .format(seconds))
-        self.path, self.steps, self.seconds = _path(path), steps, seconds
+        self.path, self.steps, self.seconds = npz_path(path), steps, seconds
         self._last_step, self._last_time = 0, None
 
     @classmethod
