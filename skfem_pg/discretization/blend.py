@@ -56,8 +56,9 @@ from skfem.element import DiscreteField
 
 from ..errors import FamilyError, SlowAssemblyWarning
 from .particles import Particles, linear_elements
-from .shape.common import FamilyGeometry, chunks, inverse_spd, weights
-from .shape.quadratic import taylor2_basis, taylor2_derivatives
+from .shape.common import FamilyGeometry, chunks
+from .shape.quadratic import (taylor2_basis, taylor2_derivatives,
+                              wte2_coefficients)
 
 
 class QuadraticFits(NamedTuple):
@@ -208,10 +209,7 @@ def quadratic_fits(particles: Particles, families=None,
     if not np.array_equal(mem[:, 0], fam.masters):
         raise FamilyError("the families must list their master first")
     geo = FamilyGeometry(particles.x, particles.volumes, mem, mask)
-    P = taylor2_basis(geo.D0)
-    Wp = (weights((geo.D0 ** 2).sum(-1), 1, floor=True) * geo.V)[..., None] \
-        * P
-    Minv, singular = inverse_spd(np.swapaxes(Wp, -1, -2) @ P)
+    c, singular = wte2_coefficients(geo, n=1)
     if singular.any():
         k = int(np.flatnonzero(singular)[0])
         raise FamilyError(
@@ -222,7 +220,7 @@ def quadratic_fits(particles: Particles, families=None,
                 int(fam.masters[k]),
                 np.round(particles.x[:, fam.masters[k]], 12).tolist(),
                 int(mask[k].sum()), int(singular.sum())))
-    return QuadraticFits(mem, mask, Wp @ Minv, geo.h, family)
+    return QuadraticFits(mem, mask, c, geo.h, family)
 
 
 def _raw(mesh, fits, base, cells, part=slice(None)):

@@ -33,6 +33,7 @@ state (the solvers detect that).
 from __future__ import annotations
 
 import numpy as np
+import scipy.sparse as sp
 import skfem as fem
 from skfem.helpers import dot
 
@@ -273,6 +274,5 @@ def _pad(r, n):
 def _pad_matrix(K, n):
     if K.shape[0] == n:
         return K
-    import scipy.sparse as sp
     K = K.tocoo()
     return sp.csr_matrix((K.data, (K.row, K.col)), shape=(n, n))

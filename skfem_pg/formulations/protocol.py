@@ -54,17 +54,23 @@ class Model(Protocol):
         """The model's extra fields of ``x`` by name (``{}`` if none)."""
 
 
+#: the members of :class:`Model`, for the messages that name the missing
+MEMBERS = ("basis", "n_u", "N", "initial", "state", "internal_force",
+           "tangent", "min_J", "commit", "fields")
+
+
+def _missing(model):
+    return ", ".join(m for m in MEMBERS if not hasattr(model, m))
+
+
 def check_model(model, token):
     """``model`` if it satisfies :class:`Model`, else ``TypeError`` naming
     the formulation ``token`` and the missing members."""
     if isinstance(model, Model):
         return model
-    missing = [m for m in ("basis", "n_u", "N", "initial", "state",
-                           "internal_force", "tangent", "min_J", "commit",
-                           "fields") if not hasattr(model, m)]
     raise TypeError("formulation {!r} built a {} without {} (the model "
                     "protocol, skfem_pg.formulations.protocol.Model)".format(
-                        token, type(model).__name__, ", ".join(missing)))
+                        token, type(model).__name__, _missing(model)))
 
 
 def require_model(model, driver):
@@ -74,10 +80,6 @@ def require_model(model, driver):
     probing."""
     if isinstance(model, Model):
         return model
-    missing = [m for m in ("basis", "n_u", "N", "initial", "state",
-                           "internal_force", "tangent", "min_J", "commit",
-                           "fields") if not hasattr(model, m)]
     raise TypeError("{} takes a model (skfem_pg.formulations.protocol."
                     "Model); {} lacks {}".format(
-                        driver, type(model).__name__, ", ".join(missing)))
-
+                        driver, type(model).__name__, _missing(model)))

@@ -55,6 +55,20 @@ def taylor2_derivatives(D):
     return np.concatenate([lin, np.stack(rows, axis=-2)], axis=-2)
 
 
+def wte2_coefficients(geo, n=1):
+    r"""The WTE2 fit of the families of ``geo`` (a :class:`FamilyGeometry`)
+    with weights :math:`|\Delta X|^{-2n}` (5.41): ``(c, singular)``, the
+    monomial coefficients per member ``c[k, i, q]`` (offsets scaled by
+    ``geo.h``; the master's column unused) and which families' moment
+    matrices are singular."""
+    D = geo.D0
+    W = weights((D ** 2).sum(-1), n, floor=True) * geo.V  # master: r2 = 0
+    p = taylor2_basis(D)  # (k, i, q)
+    Wp = W[..., None] * p
+    Minv, singular = inverse_spd(np.swapaxes(Wp, -1, -2) @ p)
+    return Wp @ Minv, singular  # M symmetric
+
+
 def wte2_gradients(x, volumes, fam, n=1):
     """WTE2 derivatives, shape ``(nf, m, m, d)`` (U2)."""
     return wte2_at(x, volumes, fam, n=n)
@@ -74,17 +88,10 @@ def wte2_at(x, volumes, fam, points=None, n=1):
     G = np.zeros((nf, P, m, d))
     for sl in chunks(nf, max(m, P) * m * q):
         geo = FamilyGeometry(x, volumes, mem_all[sl], mask_all[sl])
-        D = geo.D0
-        # the master has r2 = 0
-        W = weights((D ** 2).sum(-1), n, floor=True) * geo.V
-        p = taylor2_basis(D)  # (k, i, q)
-        Wp = W[..., None] * p
-        M = np.swapaxes(Wp, -1, -2) @ p  # (k, q, q)
-        Minv, singular = inverse_spd(M)
+        c, singular = wte2_coefficients(geo, n)  # (k, i, q)
         check_singular(x, fam, sl, geo, singular, "WTE2", False)
-        c = Wp @ Minv  # (k, i, q): coefficients, M symmetric
         if points is None:
-            Y, at = D, geo.mask
+            Y, at = geo.D0, geo.mask
         else:
             Y = (points[sl] - x.T[mem_all[sl, :1]]) / geo.h[:, None, None]
             at = np.ones(Y.shape[:2], dtype=bool)
