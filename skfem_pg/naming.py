@@ -39,6 +39,13 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
 ``MQ``      a package token: the moment-matched family quadrature
             (:mod:`skfem_pg.discretization.moment_quadrature`) of U2
             instead of the members
+``k=v``     package options at the end, for what Table 7.1 has no word
+            for: ``families=`` a rule (``nearest``, ``horizon``,
+            ``mesh``) or ``given`` (pass ``families=`` to
+            :meth:`~skfem_pg.FamilyBasis.from_name`), ``weights=``
+            ``uniform`` / ``volume``, ``n=`` the bond weight exponent,
+            ``test=`` PPG's test derivatives, ``lme_mu=``, ``solver=`` the
+            VC solve, ``exclude=given`` (pass ``vc_exclude=``)
 ==========  ==============================================================
 
 So ``"VCPBG Unl"`` means ``"VCBCPBG V5sn Unl TL"`` and ``"PBG Unl"`` means
@@ -50,6 +57,16 @@ same patch tests and is less erratic than ``sn`` on 3-D tetrahedra
 vc_boundary="min-norm")`` or
 the suffix ``m`` gets it for a thesis name.
 
+:func:`name_of` prints every option of a basis this way, so that the name
+of any basis gives the basis back:
+
+>>> import skfem as fem, skfem_pg as pg
+>>> p = pg.Particles.from_mesh(fem.MeshQuad().refined(2))
+>>> pg.FamilyBasis(p, "horizon", dim=2).name
+'VCBCPBG V5m Unl TL families=horizon'
+>>> pg.FamilyBasis(p, "nearest", dim=2, weights="volume").name
+'VCBCPBG V5m Unl TL families=nearest n=0'
+
 Every formulation of Table 7.1 parses: :func:`parse` gives the options of
 its *displacement* basis (MTE1 for ``UnlP0``, WTE2 for ``U2P1``, ...) and
 :func:`formulation_of` the formulation token, which
@@ -60,7 +77,7 @@ built, naming it).
 import re
 
 from . import registry
-from .discretization import recipes
+from .discretization import parts, recipes
 
 # the formulation tokens (their shape functions, kinds, the UL frame) and
 # the FE comparators are those of skfem_pg.registry
@@ -68,8 +85,17 @@ _NAME = re.compile(r"^(?P<vc>VC2|VC)?(?P<bc>BC)?(?P<method>PBG|PPG1|PPG2|PPG)"
                    r"(?:\s+(?P<variant>V[1-5])?(?P<boundary>sn|s|p|m)?)?"
                    r"\s+(?P<form>\S+)(?:\s+(?P<frame>TL|UL))?"
                    r"(?:\s+(?P<nobc>noBC))?(?:\s+(?P<recipe>kNN|meshU))?"
-                   r"(?:\s+(?P<quad>MQ))?$")
+                   r"(?:\s+(?P<quad>MQ))?"
+                   r"(?P<options>(?:\s+[a-z_]+=\S+)*)$")
 _BOUNDARY = {"p": "p", "s": "s", "sn": "sn", "m": "min-norm"}
+#: what the options ``families=given`` and ``exclude=given`` stand for:
+#: arrays the name cannot hold, passed beside it
+GIVEN = "given"
+#: name option -> (keyword, conversion)
+_OPTIONS = {"families": ("families", str), "weights": ("weights", str),
+            "n": ("weight_exponent", float), "test": ("test_shape", str),
+            "lme_mu": ("lme_mu", float), "solver": ("vc_solver", str),
+            "exclude": ("vc_exclude", str)}
 
 
 def fe_method(name):
@@ -131,8 +157,6 @@ def parse(name):
             "{!r}: the updated Lagrangian frame (UL) is built for the "
             "displacement formulations {} of PBG".format(
                 name, ", ".join(registry.tokens(updated_lagrangian=True))))
-    if g["frame"] == "UL" and g["method"] != "PBG":
-        raise NotImplementedError("{!r}: UL is built for PBG".format(name))
     method = {"PPG": "PPG1"}.get(g["method"], g["method"])
     first_order, shape = record.first_order, record.shape
     if g["bc"] and not first_order:
@@ -165,12 +189,13 @@ def parse(name):
         kw.pop("weights")
         kw["family_quadrature"] = "moments"
     notes = []
+    kw.update(_options(name, g["options"]))
     if g["vc"] is None:
         if g["variant"] or g["boundary"]:
             raise ValueError("{!r}: a correction variant or boundary variant "
                              "without 'VC'".format(name))
         kw["vc"] = None
-        return kw, notes
+        return _checked(name, kw, g["frame"]), notes
     if g["vc"] == "VC2":
         kw["vc"] = "VC2"
         own = "V4" if method == "PBG" else "V1"
@@ -181,16 +206,51 @@ def parse(name):
         kw["vc"] = g["variant"] or ("V5" if method == "PBG" and kw["bond"]
                                     else "V3")
     kw["vc_boundary"] = _BOUNDARY[g["boundary"] or "sn"]
-    if kw["vc"] == "VC2" and kw["vc_boundary"] == "sn":
-        raise NotImplementedError(
-            "{!r}: VC2 has the boundary variant 's' (e.g. 'VC2PPG V1s U2') "
-            "and the minimum-norm solve ('m'), not the default 'sn'"
-            .format(name))
-    if method == "PPG2" and kw["vc_boundary"] != "min-norm":
-        raise NotImplementedError(
-            "{!r}: the VC of PPG2 has only the minimum-norm solve: write "
-            "the suffix 'm' (e.g. 'VCPPG2 V3m Unl')".format(name))
-    return kw, notes
+    return _checked(name, kw, g["frame"]), notes
+
+
+def _options(name, text):
+    """The keywords of the ``k=v`` options at the end of a name."""
+    kw = {}
+    for item in text.split():
+        key, _, value = item.partition("=")
+        if key not in _OPTIONS or key in kw:
+            raise ValueError("{!r}: {} option {!r}; the options are {}".format(
+                name, "a repeated" if key in kw else "an unknown", key,
+                ", ".join(k + "=" for k in _OPTIONS)))
+        keyword, kind = _OPTIONS[key]
+        try:
+            kw[keyword] = kind(value)
+        except ValueError:
+            raise ValueError("{!r}: {}={!r} is not a number".format(
+                name, key, value)) from None
+    if kw.get("vc_exclude", GIVEN) != GIVEN:
+        raise ValueError("{!r}: exclude= takes 'given' (pass the particles "
+                         "as vc_exclude=)".format(name))
+    return kw
+
+
+def _checked(name, kw, frame):
+    """``kw``, after the parts of :mod:`skfem_pg.discretization.parts`
+    have said that they work together (and in the UL frame)."""
+    try:
+        ps = parts.Parts(
+            shape=parts.Shape(kw["shape"], kw.get("weight_exponent", 1.0)),
+            quadrature=parts.Quadrature(
+                kw.get("weights", "uniform"),
+                kw.get("family_quadrature", "members")),
+            correction=parts.Correction(
+                kw["bond"], kw["vc"], kw.get("vc_boundary", "min-norm"),
+                kw.get("vc_solver", "auto"),
+                kw.get("vc_exclude") or None),
+            method=parts.Method(kw["method"], kw.get("test_shape", "master"),
+                                kw.get("lme_mu", 1.8)))
+        parts.check(ps)
+        if frame == "UL":
+            parts.require("updated_lagrangian", ps)
+    except (ValueError, NotImplementedError) as err:
+        raise type(err)("{!r}: {}".format(name, err)) from None
+    return kw
 
 
 def knn_name(name):
@@ -205,25 +265,56 @@ def knn_name(name):
 
 
 def name_of(basis):
-    """The full thesis code of a :class:`~skfem_pg.FamilyBasis`, e.g.
-    ``"VCBCPBG V5m Unl TL"``: every option written, so that
-    :func:`parse` gives the basis back."""
-    vc = basis.vc
+    """The full thesis code of a :class:`~skfem_pg.FamilyBasis` (or its
+    :class:`~skfem_pg.discretization.BasisSpec`), e.g.
+    ``"VCBCPBG V5m Unl TL"``: every option written, those Table 7.1 has no
+    word for as ``k=v`` options, so that :func:`parse` gives the basis
+    back (given families and excluded particles are named ``given``)."""
+    spec = getattr(basis, "spec", basis)
+    vc = spec.vc
     form = {registry.formulation(f).shape: f for f in reversed(
-        registry.tokens(kind="displacement"))}[basis.shape]
+        registry.tokens(kind="displacement"))}[spec.shape]
     first_order = registry.formulation(form).first_order
     prefix = ("VC2" if vc == "VC2" else "VC" if vc else "") + \
-        ("BC" if basis.bond else "")
-    method = {"PPG1": "PPG"}.get(basis.method, basis.method)
+        ("BC" if spec.bond else "")
+    method = {"PPG1": "PPG"}.get(spec.method, spec.method)
     if vc == "VC2":
-        variant = " V4" if basis.method == "PBG" else " V1"
+        variant = " V4" if spec.method == "PBG" else " V1"
     else:
         variant = " " + vc if vc else ""
     if vc:
-        variant += {v: k for k, v in _BOUNDARY.items()}[basis.vc_boundary]
-    tail = " noBC" if first_order and not basis.bond else ""
-    if getattr(basis, "recipe", None) in ("kNN", "meshU"):
-        tail += " " + basis.recipe
-    if getattr(basis, "family_quadrature", "members") == "moments":
+        variant += {v: k for k, v in _BOUNDARY.items()}[spec.vc_boundary]
+    tail = " noBC" if first_order and not spec.bond else ""
+    if spec.recipe in ("kNN", "meshU"):
+        tail += " " + spec.recipe
+    moments = spec.family_quadrature == "moments"
+    if moments:
         tail += " MQ"
-    return "{}{}{} {} TL{}".format(prefix, method, variant, form, tail)
+    return "{}{}{} {} TL{}{}".format(prefix, method, variant, form, tail,
+                                     "".join(" {}={}".format(*kv) for kv in
+                                             _options_of(spec, moments)))
+
+
+def _options_of(spec, moments):
+    """The ``(key, value)`` options a name needs beyond its tokens to
+    give ``spec`` back (what :func:`parse` does not default to)."""
+    rule = spec.family_rule
+    if rule.given:
+        yield "families", GIVEN
+    elif not rule.parameters and spec.recipe not in ("kNN", "meshU") and (
+            moments or spec.shape == "WTE2" or rule.rule != "mesh"):
+        yield "families", rule.rule  # the defaults have parameters
+    if spec.recipe not in ("kNN", "meshU") and not moments:
+        w, n = recipes.RECIPES["mesh"][1:]  # the thesis'
+        if spec.weights != w:
+            yield "weights", spec.weights
+        if spec.weight_exponent != n:
+            yield "n", "{:g}".format(spec.weight_exponent)
+    if spec.test_shape != "master":
+        yield "test", spec.test_shape
+        if spec.test_shape == "LME" and spec.lme_mu != 1.8:
+            yield "lme_mu", "{!r}".format(spec.lme_mu)
+    if spec.vc_solver != "auto":
+        yield "solver", spec.vc_solver
+    if spec.vc_exclude is not None:
+        yield "exclude", GIVEN

@@ -5,7 +5,7 @@ import pytest
 import skfem as fem
 
 import skfem_pg as pg
-from skfem_pg.discretization import BasisSpec, builder
+from skfem_pg.discretization import BasisSpec, builder, parts
 
 
 @pytest.fixture
@@ -16,8 +16,9 @@ def particles():
 def test_spec_resolves_defaults_once(particles):
     s = BasisSpec.resolve(particles, dim=2)
     assert (s.shape, s.bond, s.vc, s.method, s.weights, s.weight_exponent,
-            s.families, s.recipe) == ("MTE1", True, "V5", "PBG", "uniform",
-                                      0.0, "mesh", "meshU")  # triangles
+            s.family_rule, s.recipe) == (
+                "MTE1", True, "V5", "PBG", "uniform", 0.0,
+                parts.FamilyRule("mesh"), "meshU")  # triangles
     assert s.grouped  # the default runs per size group, unpadded
     p = BasisSpec.resolve(particles, dim=2, method="PPG1")
     assert (p.vc, p.grouped) == ("V3", False)

@@ -317,3 +317,47 @@ def _strip():
         np.linspace(0, 4, 9), np.linspace(0, 1, 3)).with_boundaries(
         {"left": lambda x: np.isclose(x[0], 0),
          "right": lambda x: np.isclose(x[0], 4)})
+
+
+@pytest.mark.parametrize("kw", [
+    {}, dict(families="mesh"), dict(families="horizon"),
+    dict(families="nearest"), dict(families="nearest", weights="volume"),
+    dict(weight_exponent=0.5), dict(shape="WTE1", bond=False, vc="V3"),
+    dict(shape="WTE2"), dict(shape="WTE2", families="horizon"),
+    dict(shape="WTE2", family_quadrature="moments"),
+    dict(method="PPG1"), dict(method="PPG1", families="nearest"),
+    dict(method="PPG1", test_shape="LME", lme_mu=2.5),
+    dict(vc_boundary="p"), dict(vc_solver="local"), dict(vc=None),
+    dict(vc_solver="lsqr", vc_exclude=[0, 1]),
+])
+def test_every_basis_name_gives_the_basis_back(kw):
+    """name_of prints what Table 7.1 has no word for as k=v options: the
+    spec of the name is the spec named (given arrays passed beside)."""
+    from skfem_pg.discretization import BasisSpec
+    p = pg.Particles.from_mesh(square(5, 0.2, seed=3))
+    spec = BasisSpec.resolve(p, dim=2, **kw)
+    beside = {k: kw[k] for k in ("vc_exclude",) if k in kw}
+    back, _ = BasisSpec.from_name(p, spec.name, dim=2, **beside)
+    assert back == spec, spec.name
+
+
+def test_a_family_rule_of_ones_own_is_named():
+    """A rule added to RULES: the basis' name says so and gives it back;
+    given families are named 'given' and must be passed beside."""
+    from skfem_pg.discretization import BasisSpec, families
+    p = pg.Particles.from_mesh(square(5, 0.2, seed=3))
+    rules = dict(families.RULES, wide=lambda q: families.horizon(
+        q, factor=2.2))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(families, "RULES", rules)
+        b = pg.FamilyBasis(p, "wide", dim=2)
+        assert b.name == "VCBCPBG V5m Unl TL families=wide"
+        assert BasisSpec.from_name(p, b.name, dim=2)[0] == b.spec
+    fam = families.nearest(p, 7)
+    spec = BasisSpec.resolve(p, dim=2, families=fam)
+    assert spec.name.endswith("families=given")
+    with pytest.raises(ValueError, match="pass families="):
+        BasisSpec.from_name(p, spec.name, dim=2)
+    assert BasisSpec.from_name(p, spec.name, dim=2, families=fam)[0] == spec
+    with pytest.raises(ValueError, match="unknown option 'familes'"):
+        parse("VCPBG Unl familes=mesh")

@@ -18,8 +18,11 @@ systems.
                            ``vc_boundary``, ``vc2``: boundary variants, VC2
 ``petrov``                 PPG test bases (4.21), (4.22)
 ``layout``                 families grouped by size (unpadded hot paths)
-``builder``                :class:`BasisSpec` (every option, resolved) and the
-                           stages one builder composes into a basis
+``parts``                  the parts of a basis (family rule, shape,
+                           quadrature, correction, method) and what each
+                           supports: the one capability table
+``builder``                :class:`BasisSpec` (the parts, resolved from the
+                           keywords) and the stages one builder composes
 ``basis``                  :class:`FamilyBasis`, the container of the built
                            arrays behind scikit-fem's basis interface
 ``blend``                  :class:`BlendBasis` (PG2): the families' quadratic

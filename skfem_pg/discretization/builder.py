@@ -1,9 +1,11 @@
-r"""How a :class:`~skfem_pg.FamilyBasis` is made: a recipe record and the
-stages one builder composes.
+r"""How a :class:`~skfem_pg.FamilyBasis` is made: its parts and the stages
+one builder composes.
 
 A basis is the result of a fixed sequence of stages, each a plain function
-of the particles, the :class:`BasisSpec` (every option, resolved and
-checked once) and what the earlier stages computed:
+of the particles, the :class:`BasisSpec` (its parts,
+:mod:`~skfem_pg.discretization.parts`, resolved from the keywords and
+checked against each other when made) and what the earlier stages
+computed:
 
 1. **families** — a rule of
    :data:`skfem_pg.discretization.families.RULES` or given
@@ -29,8 +31,11 @@ V3/V5 or no correction runs stages 2–5 one family-size group at a time
 
 A new shape function, family rule, test rule or correction is one function
 plus one entry in its table (``GRADIENTS``, ``RULES``,
-:data:`TEST_GRADIENTS`, :data:`CORRECTIONS`).  The thesis names of Table 7.1
-produce a :class:`BasisSpec` through :meth:`BasisSpec.from_name`.
+:data:`TEST_GRADIENTS`, :data:`CORRECTIONS`); what it works with and
+supports (MPI, the grouped path, crack-aware rebuilds) its part says in
+:mod:`~skfem_pg.discretization.parts`.  The thesis names of Table 7.1
+produce a :class:`BasisSpec` through :meth:`BasisSpec.from_name`, and
+:attr:`BasisSpec.name` prints it back.
 """
 import dataclasses
 import time
@@ -54,15 +59,13 @@ from .shape.least_squares import (mls1_master_gradients,
 from .shape.lme import lme_master_gradients
 from .vc2 import vc2_correction
 from .moment_quadrature import moment_quadrature
-from .moment_quadrature import default_families as moment_families
+from .moment_quadrature import family_options as moment_family_options
 from . import local_vc
-from ..naming import parse
+from . import parts as parts_mod
+from ..naming import GIVEN, name_of, parse
 
-METHODS = ("PBG", "PPG1", "PPG2")
-#: the VC variants each kind of method accepts
-#: (:func:`~skfem_pg.discretization.corrections.correction_functions`)
-VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
-               "PPG": ("V1", "V2", "V3", "V4", "VC2")}
+METHODS = parts_mod.METHODS
+VC_VARIANTS = parts_mod.VC_VARIANTS
 
 
 def _trial_at_master(p, fam, G, spec):
@@ -102,57 +105,107 @@ TEST_GRADIENTS = {
 
 @dataclasses.dataclass(frozen=True)
 class BasisSpec:
-    """Every option of a :class:`~skfem_pg.FamilyBasis`, resolved: no
-    ``"auto"`` / ``None`` defaults left, checked against each other once.
-    The keywords mean what :class:`~skfem_pg.FamilyBasis` documents; make
-    one with :meth:`resolve` (keywords) or :meth:`from_name` (a Table 7.1
-    name), build the basis with ``FamilyBasis.from_spec``."""
+    """A :class:`~skfem_pg.FamilyBasis` as its parts
+    (:class:`~skfem_pg.discretization.parts.Parts`: family rule, shape,
+    quadrature, correction, method) and its number of components ``dim``
+    (``None``: a scalar field), checked against each other when made.
+    Make one with :meth:`resolve` (the keywords of
+    :class:`~skfem_pg.FamilyBasis`, defaults filled in) or
+    :meth:`from_name` (a Table 7.1 name); build the basis with
+    ``FamilyBasis.from_spec``.  The keywords read back as attributes
+    (``spec.vc``, ``spec.shape``, ...).
 
-    families: object  # rule name or Families
-    shape: str
-    bond: bool
-    vc: Optional[str]
-    method: str
-    dim: Optional[int]
-    weights: str
-    weight_exponent: float
-    vc_solver: str = "auto"
-    vc_exclude: object = None
-    test_shape: str = "master"
-    lme_mu: float = 1.8
-    vc_boundary: str = "min-norm"
-    vc_tolerance: Optional[float] = 1e-8
-    #: the name of :data:`skfem_pg.discretization.recipes.RECIPES` whose
-    #: families, weights and exponent these are, else ``None``
-    recipe: Optional[str] = None
-    #: ``"members"`` (the thesis': the members are the quadrature points)
-    #: or ``"moments"`` (:mod:`~skfem_pg.discretization.moment_quadrature`)
-    family_quadrature: str = "members"
+    >>> import skfem as fem, skfem_pg as pg
+    >>> spec = BasisSpec.resolve(pg.Particles.from_mesh(fem.MeshQuad()),
+    ...                          dim=2)
+    >>> spec.shape, spec.vc, spec.recipe, spec.supports("mpi")
+    ('MTE1', 'V5', 'mesh', True)
+    >>> spec.name
+    'VCBCPBG V5m Unl TL'
+    """
+
+    parts: parts_mod.Parts
+    dim: Optional[int] = None
+
+    def __post_init__(self):
+        parts_mod.check(self.parts)
+
+    # the keywords, read back from the parts
+    shape = property(lambda self: self.parts.shape.name)
+    weight_exponent = property(lambda self: self.parts.shape.weight_exponent)
+    weights = property(lambda self: self.parts.quadrature.weights)
+    family_quadrature = property(lambda self: self.parts.quadrature.rule)
+    bond = property(lambda self: self.parts.correction.bond)
+    vc = property(lambda self: self.parts.correction.vc)
+    vc_boundary = property(lambda self: self.parts.correction.boundary)
+    vc_solver = property(lambda self: self.parts.correction.solver)
+    vc_exclude = property(lambda self: self.parts.correction.exclude)
+    vc_tolerance = property(lambda self: self.parts.correction.tolerance)
+    method = property(lambda self: self.parts.method.name)
+    test_shape = property(lambda self: self.parts.method.test_shape)
+    lme_mu = property(lambda self: self.parts.method.lme_mu)
+    family_rule = property(lambda self: self.parts.family_rule)
 
     @property
     def ppg(self):
-        return self.method != "PBG"
+        return self.parts.method.petrov
+
+    @property
+    def recipe(self):
+        """The name of :data:`skfem_pg.discretization.recipes.RECIPES`
+        whose family rule, weights and exponent these are, else
+        ``None``."""
+        rule = self.family_rule
+        if self.family_quadrature != "members" or rule.given \
+                or rule.parameters:
+            return None
+        return recipes.name_of(rule.rule, self.weights,
+                               self.weight_exponent)
+
+    def supports(self, capability):
+        """Whether the parts support ``capability``
+        (:data:`~skfem_pg.discretization.parts.CAPABILITIES`)."""
+        return parts_mod.refusal(capability, self.parts) is None
+
+    def require(self, capability, what=None):
+        """Raise ``NotImplementedError`` naming the option that does not
+        support ``capability``."""
+        parts_mod.require(capability, self.parts, what)
 
     @property
     def grouped(self):
         """Whether the stages run per family-size group, without padding
         (PBG with MTE1/WTE1, vc V3/V5 or none, no excluded particles,
         boundary ``min-norm`` / ``p``)."""
-        return (not self.ppg and self.shape in ("MTE1", "WTE1")
-                and self.family_quadrature == "members"
-                and self.vc in (None, "V3", "V5") and self.vc_exclude is None
-                and self.vc_boundary in ("min-norm", "p"))
+        return self.supports("grouped")
+
+    def min_members(self, space_dim):
+        """The smallest family the parts work on (master included) in
+        ``space_dim`` dimensions."""
+        return parts_mod.min_members(self.parts, space_dim)
+
+    @property
+    def name(self):
+        """The full thesis code (:func:`skfem_pg.naming.name_of`)."""
+        return name_of(self)
 
     def options(self):
         """The keywords that rebuild a basis of this spec on moved particles
         (updated Lagrange): the family rule, not the families."""
-        out = {f.name: getattr(self, f.name)
-               for f in dataclasses.fields(self)
-               if f.name not in ("families", "recipe")}
+        out = {"shape": self.shape, "bond": self.bond, "vc": self.vc,
+               "method": self.method, "dim": self.dim,
+               "weights": self.weights,
+               "weight_exponent": self.weight_exponent,
+               "vc_solver": self.vc_solver, "vc_exclude": self.vc_exclude,
+               "test_shape": self.test_shape, "lme_mu": self.lme_mu,
+               "vc_boundary": self.vc_boundary,
+               "vc_tolerance": self.vc_tolerance,
+               "family_quadrature": self.family_quadrature}
         if self.family_quadrature == "moments":
             del out["weights"]  # the rule makes its own
-        if isinstance(self.families, str):
-            out["families"] = self.families
+        rule = self.family_rule
+        if not rule.given and not rule.parameters:
+            out["families"] = rule.rule
         return out
 
     @classmethod
@@ -162,6 +215,12 @@ class BasisSpec:
         kw, notes = parse(name)
         if particles.mesh is None and kw.get("families") == "mesh":
             kw["families"] = "horizon"  # the thesis' rule without a mesh
+        for key, given in (("families", families),
+                           ("vc_exclude", kwargs.get("vc_exclude"))):
+            if kw.get(key) == GIVEN and given is None:
+                raise ValueError(
+                    "{!r} says its {} were given: pass {}=".format(
+                        name, key.replace("vc_", ""), key))
         if families is not None:
             kw["families"] = families
         return cls.resolve(particles, **{**kw, **kwargs}), notes
@@ -176,64 +235,28 @@ class BasisSpec:
         """The spec of :class:`~skfem_pg.FamilyBasis`'s keywords, defaults
         filled in; raises ``ValueError`` / ``NotImplementedError`` naming
         the option for a combination the stages cannot build
-        (``area_vectors`` is only checked for presence)."""
+        (:mod:`~skfem_pg.discretization.parts`; ``area_vectors`` is only
+        checked for presence)."""
+        for key, value in (("families", families),
+                           ("vc_exclude", vc_exclude)):
+            if isinstance(value, str) and value == GIVEN:
+                raise ValueError(
+                    "{}='given' stands for {} passed beside a name: pass "
+                    "them as {}=".format(key, "families" if key ==
+                                         "families" else "particles", key))
         if dim is not None and (isinstance(dim, bool) or dim
                                 != particles.dim):
             raise ValueError(
                 "dim={!r} components on {}-D particles: a vector field "
                 "(displacements) has dim={}, a scalar field dim=None"
                 .format(dim, particles.dim, particles.dim))
-        if method not in METHODS:
-            raise NotImplementedError(
-                "method {!r} is not available; this version implements {}"
-                .format(method, ", ".join(METHODS)))
-        if shape not in GRADIENTS:
-            raise ValueError("unknown shape functions {!r}; available: {}"
-                             .format(shape, ", ".join(GRADIENTS)))
-        ppg = method != "PBG"
+        method = parts_mod.Method(method, test_shape, lme_mu)
+        ppg = method.petrov
         if bond is None:  # PPG too: without it VC PPG1 is unstable
             bond = shape == "MTE1"
-        if bond and shape == "WTE2":
-            raise ValueError("the bond correction (5.55) is for linear "
-                             "bases; use bond=False with shape='WTE2'")
         if vc == "auto":
             vc = {"MTE1": "V5" if bond and not ppg else "V3",
                   "WTE2": "V3"}.get(shape)
-        if vc == "VC2" and (shape != "WTE2" or method == "PPG2"):
-            raise ValueError("vc='VC2' (second-order VC) needs the quadratic "
-                             "trial basis: shape='WTE2', method='PBG' or "
-                             "'PPG1'")
-        if test_shape not in TEST_GRADIENTS:
-            raise ValueError("test_shape must be one of {}, got {!r}".format(
-                ", ".join(TEST_GRADIENTS), test_shape))
-        if test_shape != "master" and not ppg:
-            raise ValueError("test_shape={!r} is a Petrov–Galerkin option: "
-                             "use method='PPG1' or 'PPG2'".format(test_shape))
-        allowed = VC_VARIANTS["PPG" if ppg else "PBG"]
-        if vc is not None and vc not in allowed:
-            raise ValueError("vc={!r} is not available for {}: use one of {} "
-                             "or None".format(vc, method, ", ".join(allowed)))
-        if vc == "V5" and not bond:
-            raise ValueError("vc='V5' keeps the bond mapping and needs "
-                             "bond=True; use vc='V3' without bond correction")
-        if vc_solver == "local" and not (
-                method == "PBG" and shape in ("MTE1", "WTE1")
-                and vc in ("V3", "V5") and vc_boundary == "min-norm"
-                and vc_exclude is None):
-            raise NotImplementedError(
-                "vc_solver='local' (skfem_pg.discretization.local_vc) "
-                "corrects PBG on MTE1/WTE1 with vc V3 or V5, "
-                "vc_boundary='min-norm' and no vc_exclude; got {} {} vc={} "
-                "vc_boundary={!r}{}".format(
-                    method, shape, vc, vc_boundary,
-                    "" if vc_exclude is None else " with vc_exclude"))
-        if vc_boundary != "min-norm" and (
-                vc is None or method == "PPG2"
-                or (vc == "VC2" and vc_boundary != "s")):
-            raise NotImplementedError(
-                "vc_boundary={!r} is implemented for the first-order VC of "
-                "PBG and PPG1 (vc V1, V3, V4, V5) and, 's' only, for VC2; "
-                "not for {} vc={}".format(vc_boundary, method, vc))
         if vc is not None and area_vectors is None and particles.mesh is None:
             raise ValueError(
                 "the VC correction needs surface area vectors A^i: these "
@@ -242,70 +265,47 @@ class BasisSpec:
         if ppg and weights not in ("auto", None, "volume"):
             raise ValueError("weights={!r} is a PBG option: PPG integrates "
                              "with the member volumes V^j".format(weights))
-        if vc_tolerance is not None and not (
-                isinstance(vc_tolerance, (int, float, np.number))
-                and np.isfinite(vc_tolerance) and vc_tolerance > 0):
-            raise ValueError(
-                "vc_tolerance must be a positive number (the largest VC "
-                "constraint residual accepted, default 1e-8) or None (keep "
-                "any correction, with a warning), got {!r}".format(
-                    vc_tolerance))
-        if family_quadrature not in ("members", "moments"):
-            raise ValueError("family_quadrature must be 'members' or "
-                             "'moments', got {!r}".format(family_quadrature))
         if family_quadrature == "moments":
-            _check_moments(particles, shape, method, vc, vc_boundary,
-                           vc_exclude, weights)
+            if weights not in ("auto", None):
+                raise ValueError(
+                    "weights={!r}: family_quadrature='moments' makes its "
+                    "own weights (the hat functions' moments)".format(
+                        weights))
             if families is None:  # the 1-ring, a quadratic fit's members
                 if particles.mesh is None:
                     raise ValueError(
                         "family_quadrature='moments' needs particles "
                         "collocated from a mesh's vertices (their hat "
                         "functions' moments and 1-ring families)")
-                families = moment_families(particles)
+                families = parts_mod.FamilyRule("mesh", tuple(sorted(
+                    moment_family_options(particles.dim).items())))
             weights = "uniform"  # not used: the rule makes its own
         if families is None and shape == "WTE2":
             # twice the d + d(d+1)/2 quadratic moments, plus the master:
             # with fewer, corner families of graded meshes (Cook's (48,
             # 60) at 7 members) give a singular WTE2 moment matrix
             d = particles.dim
-            families = families_mod.horizon(
-                particles, factor=2.51,
-                min_size=1 + 2 * (d + d * (d + 1) // 2))
+            families = parts_mod.FamilyRule("horizon", (
+                ("factor", 2.51), ("min_size", 1 + 2 * (d + d * (d + 1) // 2))))
         elif families is None and particles.mesh is None:
             families = "horizon"
-        families, weights, weight_exponent, recipe = recipes.resolve(
-            particles, families, weights, weight_exponent, method, shape)
-        weight_rule(weights)  # a known rule, or ValueError naming it
-        return cls(families=families, shape=shape, bond=bool(bond), vc=vc,
-                   method=method, dim=dim, weights=weights,
-                   weight_exponent=recipes.check_exponent(weight_exponent),
-                   vc_solver=vc_solver, vc_exclude=vc_exclude,
-                   test_shape=test_shape, lme_mu=lme_mu,
-                   vc_boundary=vc_boundary, vc_tolerance=vc_tolerance,
-                   recipe=None if family_quadrature == "moments"
-                   else recipe, family_quadrature=family_quadrature)
-
-
-def _check_moments(particles, shape, method, vc, vc_boundary, vc_exclude,
-                   weights):
-    """Refuse what the moment quadrature does not build, naming the
-    option."""
-    if shape != "WTE2" or method != "PBG":
-        raise ValueError(
-            "family_quadrature='moments' integrates the quadratic fit WTE2 "
-            "of PBG: pass shape='WTE2' (method='PBG'), got shape={!r}, "
-            "method={!r}".format(shape, method))
-    if vc not in (None, "V3") or vc_boundary != "min-norm" \
-            or vc_exclude is not None:
-        raise NotImplementedError(
-            "family_quadrature='moments' is built with the first-order VC "
-            "V3 (or none), vc_boundary='min-norm' and no vc_exclude; got "
-            "vc={!r}, vc_boundary={!r}".format(vc, vc_boundary))
-    if weights not in ("auto", None):
-        raise ValueError("weights={!r}: family_quadrature='moments' makes "
-                         "its own weights (the hat functions' moments)"
-                         .format(weights))
+        rule = families.rule if isinstance(families, parts_mod.FamilyRule) \
+            and not families.parameters else families
+        rule, weights, weight_exponent, _ = recipes.resolve(
+            particles, rule, weights, weight_exponent, method.name, shape)
+        if ppg:  # PPG integrates with the member volumes
+            weights = "volume"
+        if not isinstance(rule, parts_mod.FamilyRule):
+            rule = parts_mod.FamilyRule(rule)
+        return cls(parts_mod.Parts(
+            family_rule=rule,
+            shape=parts_mod.Shape(shape, recipes.check_exponent(
+                weight_exponent)),
+            quadrature=parts_mod.Quadrature(weights, family_quadrature),
+            correction=parts_mod.Correction(
+                bool(bond), vc, vc_boundary, vc_solver, vc_exclude,
+                vc_tolerance),
+            method=method), dim)
 
 
 @dataclasses.dataclass
@@ -450,12 +450,10 @@ def area_vectors_of(particles, area_vectors):
 
 
 def make_families(particles, spec, distributed=None):
-    """Stage 1: the spec's families (a rule is applied; PPG's made
+    """Stage 1: the spec's families (its rule applied; PPG's made
     pairwise unless a partition made them), checked for the members the
     shape functions and corrections need."""
-    fam = spec.families
-    if isinstance(fam, str):
-        fam = families_mod.build(fam, particles)
+    fam = spec.family_rule.build(particles)
     if spec.ppg and distributed is None:  # a partition's come complete
         fam = petrov.pairwise(fam)
     check_family_sizes(particles, fam, spec)
@@ -464,9 +462,10 @@ def make_families(particles, spec, distributed=None):
 
 def check_family_sizes(p, fam, spec):
     """Raise :class:`~skfem_pg.errors.FamilyError` naming a particle whose
-    family is too small for the spec: linear Taylor expansions need ``d``
+    family is too small for the spec's parts
+    (:meth:`BasisSpec.min_members`: linear Taylor expansions need ``d``
     others, WTE2 ``d + d(d+1)/2``; MLS1 at the master (VC) ``d + 1``,
-    second-order corrections and WLS2 a quadratic basis and a constant."""
+    second-order corrections and WLS2 a quadratic basis and a constant)."""
     if fam.n_particles != p.n:
         raise FamilyError("families refer to {} particles, the particle "
                           "set has {}".format(fam.n_particles, p.n))
@@ -475,14 +474,7 @@ def check_family_sizes(p, fam, spec):
         q = fam.members[np.nonzero(inactive)[0][0]]
         raise FamilyError("{} has zero volume but is a family member"
                           .format(describe_particle(q, p.x[:, q])))
-    d = p.dim
-    need = d + 2 if spec.vc is not None else d + 1
-    q = d + d * (d + 1) // 2  # quadratic basis without constant
-    if spec.shape == "WTE2":
-        need = max(need, 1 + q)
-    if spec.vc in ("V2", "V4", "VC2") or spec.test_shape == "WLS2":
-        need = max(need, 2 + q)  # WLS2 with a constant term
-    families_mod.check_supports(p, fam, need, "{}{}".format(
+    families_mod.check_supports(p, fam, spec.min_members(p.dim), "{}{}".format(
         spec.shape, " with VC correction" if spec.vc else ""))
 
 
@@ -588,24 +580,17 @@ def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
 
 
 def distributed_supports(spec):
-    """Whether a partition can build ``spec``: the grouped PBG pipeline,
-    the moment quadrature (its VC is first-order PBG), or PPG1 with vc V3
-    or none, boundary ``min-norm`` and master test derivatives (its VC
-    solve and test derivatives span the ranks)."""
-    return spec.grouped or spec.family_quadrature == "moments" or (
-        spec.method == "PPG1" and spec.vc in (None, "V3")
-        and spec.vc_boundary == "min-norm" and spec.test_shape == "master")
+    """Whether a partition can build ``spec`` (its parts support
+    ``"mpi"``, :mod:`~skfem_pg.discretization.parts`)."""
+    return spec.supports("mpi")
 
 
 def build(particles, spec, area_vectors=None, distributed=None):
     """Run the stages of ``spec`` on ``particles``; ``distributed`` (a
     :class:`~skfem_pg.distributed.Partition`) supplies the VC solve of all
     ranks.  Returns :class:`BasisArrays`."""
-    if distributed is not None and not distributed_supports(spec):
-        raise NotImplementedError(
-            "a distributed basis is PBG with MTE1/WTE1 and vc V3/V5 "
-            "or None, WTE2 with family_quadrature='moments', or PPG1 with "
-            "vc V3 or None")
+    if distributed is not None:
+        spec.require("mpi", "a distributed basis")
     timings = {}
     t0 = time.perf_counter()
     fam = make_families(particles, spec, distributed)

@@ -133,11 +133,21 @@ def resolve(particles, families, weights, weight_exponent, method, shape):
         weights = w
     if weight_exponent in (None, "auto"):
         weight_exponent = n
-    key = (families if isinstance(families, str) else None, weights,
+    return families, weights, weight_exponent, name_of(
+        families, weights, weight_exponent)
+
+
+def name_of(rule, weights, weight_exponent):
+    """The name of the recipe that is family rule ``rule``, ``weights``
+    and ``weight_exponent``, else ``None`` (given families, other
+    combinations).
+
+    >>> name_of("nearest", "uniform", 0), name_of("nearest", "volume", 0)
+    ('kNN', None)
+    """
+    key = (rule if isinstance(rule, str) else None, weights,
            weight_exponent)
-    names = ([default] if default else []) + list(RECIPES)
-    recipe = next((k for k in names if RECIPES[k] == key), None)
-    return families, weights, weight_exponent, recipe
+    return next((k for k, v in RECIPES.items() if v == key), None)
 
 
 def weights_of_rule(rule):
@@ -164,5 +174,6 @@ def check_exponent(n):
     return v
 
 
-__all__ = ["RECIPES", "default_recipe", "resolve", "weights_of_rule",
+__all__ = ["RECIPES", "default_recipe", "name_of", "resolve",
+           "weights_of_rule",
            "check_exponent"]

@@ -53,6 +53,7 @@ from ..discretization import petrov
 from ..discretization import recipes
 from ..discretization.moment_quadrature import family_options, hat_moments
 from ..discretization.basis import FamilyBasis
+from ..discretization.builder import BasisSpec
 from ..discretization.families import Families
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
@@ -287,27 +288,12 @@ class Partition:
         :attr:`local` (local → global particle; a partition holds one
         local numbering, the last basis') and returns the basis."""
         method = options.get("method", "PBG")
-        if method not in ("PBG", "PPG1"):
-            raise NotImplementedError(
-                "method={!r} on MPI: this version distributes PBG and PPG1"
-                .format(method))
         moments = options.get("family_quadrature") == "moments"
-        if options.get("shape", "MTE1") not in ("MTE1", "WTE1") \
-                and not moments:
-            raise NotImplementedError(
-                "shape={!r} on MPI: this version distributes the linear "
-                "bases MTE1 and WTE1, and WTE2 with family_quadrature="
-                "'moments'".format(options["shape"]))
-        for key, allowed in (("vc_boundary", ("min-norm", "p")),
-                             ("vc_exclude", (None,))):
-            if options.get(key, allowed[0]) not in allowed:
-                raise NotImplementedError(
-                    "{}={!r} on MPI: the distributed VC solve takes {}"
-                    .format(key, options[key], allowed))
-        if options.get("vc", "auto") not in ("auto", "V3", "V5", None):
-            raise NotImplementedError(
-                "vc={!r} on MPI: the distributed VC solve takes V3, V5 or "
-                "None".format(options["vc"]))
+        # what the parts of the basis support on ranks (one table:
+        # skfem_pg.discretization.parts), before any family is built
+        BasisSpec.resolve(self.particles, families=families, **{
+            k: v for k, v in options.items() if k != "area_vectors"}
+        ).require("mpi", "on MPI")
         rule = ("moments" if moments and families is None
                 else self._family_rule(families, method, options))
         fam = error = None

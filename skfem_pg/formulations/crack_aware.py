@@ -246,11 +246,10 @@ def _check_crack_inputs(basis, material, fraction, what):
         raise ValueError("crack-aware families remove failed cells of "
                          "the collocation mesh: the particles must be "
                          "a mesh's vertices (Particles.from_mesh)")
-    if part is None and basis.options.get("families") != "mesh":
-        raise ValueError(
-            "crack-aware families rebuild the families from the intact "
-            "cells: the basis needs the 'mesh' family rule, got {!r}"
-            .format(basis.spec.families))
+    why = None if part is not None else basis.spec.parts.family_rule \
+        .refusal("crack_rebuild", basis.spec.parts)
+    if why is not None:  # a rank's families follow the partition's rule
+        raise ValueError(why)
     damage = getattr(material, "damage", None)
     if not getattr(material, "stateful", False) or damage is None:
         raise ValueError("{!r} has no damage law: nothing can fail "

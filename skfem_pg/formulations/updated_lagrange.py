@@ -104,10 +104,11 @@ class UpdatedLagrange(Hyperelastic):
     ``model.current`` is the basis of the last update."""
 
     def __init__(self, basis, material, every=1):
-        if not isinstance(basis, FamilyBasis) or basis.is_petrov:
+        if not isinstance(basis, FamilyBasis):
             raise ValueError("the updated Lagrangian frame is built for PBG "
                              "family bases, got {}".format(
                                  type(basis).__name__))
+        basis.spec.require("updated_lagrangian")  # PBG at the members
         p = basis.particles
         if p.kind != "vertices" or p.mesh is None:
             raise ValueError("UL moves the collocation mesh with the "
@@ -115,13 +116,6 @@ class UpdatedLagrange(Hyperelastic):
                              "particles must come from Particles.from_mesh")
         if int(every) < 1:
             raise ValueError("every must be >= 1, got {}".format(every))
-        if getattr(basis, "family_quadrature", "members") != "members":
-            raise NotImplementedError(
-                "UL with family_quadrature={!r}: the history is carried "
-                "over between the members of old and new families, and "
-                "the moment quadrature's points are not members (they "
-                "move with the hat functions' principal axes)".format(
-                    basis.family_quadrature))
         super().__init__(basis, material)
         self.every = int(every)
         self.current = basis
