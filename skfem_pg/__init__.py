@@ -29,7 +29,7 @@ from .discretization import (Particles, Families, FamilyBasis, assemble,
 from .io import write_vtu
 from .scenes import Scene
 from .solvers import (newton, newmark, central_difference, lumped_mass,
-                      NewtonControls)
+                      NewtonControls, Problem)
 from .registry import register as register_formulation
 
 __version__ = "0.1.0"
@@ -44,4 +44,4 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "ParticleError", "FamilyError", "CorrectionError",
            "UnsupportedMeshError", "registry", "register_formulation",
            "Scene", "newton", "newmark", "central_difference",
-           "lumped_mass", "NewtonControls"]
+           "lumped_mass", "NewtonControls", "Problem"]

@@ -10,7 +10,7 @@ from scipy.optimize import brentq
 import skfem_pg as pg
 from skfem_pg.errors import FamilyError
 from skfem_pg.formulations import CrackAware, CrackAwareU1SIG
-from skfem_pg.formulations.crack_aware import pieces, separate
+from skfem_pg.discretization.cracks import pieces, separate
 from skfem_pg.materials import J2Plasticity, NeoHooke
 from skfem_pg.solvers.checkpoint import Every
 

@@ -210,6 +210,10 @@ def test_prescribed_displacement_newton():
     u, _ = dist.newton(Hyperelastic(part.basis(dim=3), mat), part, D=D,
                        u_D=u_D, steps=2, tol=1e-12, verbose=False)
     assert rel(u, u_s) <= 1e-10
+    # the same run posed as a Problem (serial vectors, the rank's model)
+    problem = pg.Problem(Hyperelastic(part.basis(dim=3), mat), D=D, u_D=u_D)
+    sol = dist.newton(problem, part, steps=2, tol=1e-12, verbose=False)
+    assert np.array_equal(sol.x, u)
 
 
 @pytest.mark.parametrize("kw", [dict(), dict(vc_boundary="p"),
@@ -531,10 +535,17 @@ def test_explicit_fe_equals_serial(element):
                                wall=_wall(), verbose=False)
     part = dist.Partition(mesh, COMM, fe_elements=np.arange(mesh.nelements))
     b = part.fe_basis(e)
+    wall = _wall()
     td = dist.central_difference(Hyperelastic(b, material), part,
                                  dist.lumped_mass(b, part, 1.0), T_END, v0=v0,
-                                 wall=_wall(), verbose=False)
+                                 wall=wall, verbose=False)
     assert_runs_agree(td, ts)
+    assert wall.tol is None  # the caller's wall is not changed
+    problem = pg.Problem(Hyperelastic(b, material), walls=wall,
+                         mass=dist.lumped_mass(b, part, 1.0))
+    tp = dist.central_difference(problem, part, t_end=T_END, v0=v0,
+                                 verbose=False)
+    assert np.array_equal(tp.x, td.x) and tp.steps == td.steps
 
 
 def _killed_at(call):

@@ -144,3 +144,47 @@ def test_drivers_name_what_a_model_lacks(beam):
                           "x", m, np.zeros(3)), "checkpoint.save")):
         with pytest.raises(TypeError, match=name + ".*lacks N"):
             run(NoN())
+
+
+def test_a_problem_is_the_same_run_as_the_keywords(beam):
+    """Issue 49: model, loads, Dirichlet data, walls and mass as one record
+    (pg.Problem); each driver gives the keyword run's numbers bit for bit,
+    and a keyword beside a Problem is refused, naming it."""
+    b, f, D = beam
+    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    problem = pg.Problem(model, f_ext=f, D=D)
+    sol = newton(problem, verbose=False)
+    x, hist = newton(model, f, D=D, verbose=False)
+    assert np.array_equal(sol.x, x) and len(sol.history) == len(hist)
+    m = lumped_mass(b, 1.0)
+    dyn = problem.replace(mass=m)
+    a = newmark(dyn, t_end=0.5, dt=0.1, verbose=False)
+    k = newmark(model, m, 0.5, 0.1, f_ext=f, D=D, verbose=False)
+    assert np.array_equal(a.x, k.x) and np.array_equal(a.v, k.v)
+    a = central_difference(dyn, t_end=0.02, verbose=False)
+    k = central_difference(model, m, 0.02, f_ext=f, D=D, verbose=False)
+    assert np.array_equal(a.x, k.x) and a.steps == k.steps
+    with pytest.raises(TypeError, match=r"newton\(problem, f_ext=\)"):
+        newton(problem, f)
+    with pytest.raises(TypeError, match="carries its mass"):
+        newmark(dyn, 0.5, 0.1)  # t_end in the mass' place
+    with pytest.raises(ValueError, match="give the lumped mass"):
+        central_difference(problem, t_end=0.02)
+    with pytest.raises(TypeError, match="is not a RigidWall"):
+        pg.Problem(model, walls=[1.0])
+
+
+def test_a_wall_serves_several_runs_unchanged():
+    """The drivers bind copies of the walls: a wall without tol takes the
+    default of each body it meets (it kept the first body's before)."""
+    from skfem_pg.solvers import RigidWall
+    wall = RigidWall(0, 0.0)
+    for length in (1.0, 100.0):
+        mesh = fem.MeshQuad.init_tensor(np.linspace(0, length, 5),
+                                        np.linspace(0, 1, 2))
+        b = pg.FamilyBasis(mesh, dim=2)
+        model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+        v0 = np.where(np.arange(b.N) % 2 == 0, -0.1, 0.0)
+        central_difference(model, lumped_mass(b, 1.0), 0.01, v0=v0,
+                           wall=wall, verbose=False)
+        assert wall.tol is None and not hasattr(wall, "dofs")

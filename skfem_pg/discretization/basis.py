@@ -373,16 +373,11 @@ class FamilyBasis(AbstractBasis):
 
     def _hold(self, particles, spec, arrays, distributed):
         """Keep the built arrays and set what scikit-fem's assembly reads."""
-        self.particles, self.spec = particles, spec
-        self.shape, self.bond, self.vc = spec.shape, spec.bond, spec.vc
-        self.method, self.weights = spec.method, spec.weights
-        self.weight_exponent, self.recipe = spec.weight_exponent, spec.recipe
-        self.test_shape, self.vc_boundary = spec.test_shape, spec.vc_boundary
+        self.particles, self.spec = particles, spec  # options: see below
         #: what rebuilds this basis on moved particles (updated Lagrange)
         self.options = spec.options()
         self.distributed = distributed
         self.families, self.dx = arrays.families, arrays.dx
-        self.family_quadrature = spec.family_quadrature
         #: ``family_quadrature="moments"``: the values ``(nf, m, m)`` and
         #: positions ``(nf, m, d)`` of the quadrature slots; ``None``: the
         #: members (values :math:`\delta_{ij}`)
@@ -430,6 +425,18 @@ class FamilyBasis(AbstractBasis):
                 if distributed is None else
                 distributed.reverse_master_derivatives(Gm, self.families))
             self.test.trial = self
+
+    # the options, read from the spec (spec.parts: the one record of them)
+    shape = property(lambda self: self.spec.shape)
+    bond = property(lambda self: self.spec.bond)
+    vc = property(lambda self: self.spec.vc)
+    method = property(lambda self: self.spec.method)
+    weights = property(lambda self: self.spec.weights)
+    weight_exponent = property(lambda self: self.spec.weight_exponent)
+    recipe = property(lambda self: self.spec.recipe)
+    test_shape = property(lambda self: self.spec.test_shape)
+    vc_boundary = property(lambda self: self.spec.vc_boundary)
+    family_quadrature = property(lambda self: self.spec.family_quadrature)
 
     @property
     def is_petrov(self):

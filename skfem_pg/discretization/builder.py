@@ -130,20 +130,6 @@ class BasisSpec:
     def __post_init__(self):
         parts_mod.check(self.parts)
 
-    # the keywords, read back from the parts
-    shape = property(lambda self: self.parts.shape.name)
-    weight_exponent = property(lambda self: self.parts.shape.weight_exponent)
-    weights = property(lambda self: self.parts.quadrature.weights)
-    family_quadrature = property(lambda self: self.parts.quadrature.rule)
-    bond = property(lambda self: self.parts.correction.bond)
-    vc = property(lambda self: self.parts.correction.vc)
-    vc_boundary = property(lambda self: self.parts.correction.boundary)
-    vc_solver = property(lambda self: self.parts.correction.solver)
-    vc_exclude = property(lambda self: self.parts.correction.exclude)
-    vc_tolerance = property(lambda self: self.parts.correction.tolerance)
-    method = property(lambda self: self.parts.method.name)
-    test_shape = property(lambda self: self.parts.method.test_shape)
-    lme_mu = property(lambda self: self.parts.method.lme_mu)
     family_rule = property(lambda self: self.parts.family_rule)
 
     @property
@@ -192,15 +178,8 @@ class BasisSpec:
     def options(self):
         """The keywords that rebuild a basis of this spec on moved particles
         (updated Lagrange): the family rule, not the families."""
-        out = {"shape": self.shape, "bond": self.bond, "vc": self.vc,
-               "method": self.method, "dim": self.dim,
-               "weights": self.weights,
-               "weight_exponent": self.weight_exponent,
-               "vc_solver": self.vc_solver, "vc_exclude": self.vc_exclude,
-               "test_shape": self.test_shape, "lme_mu": self.lme_mu,
-               "vc_boundary": self.vc_boundary,
-               "vc_tolerance": self.vc_tolerance,
-               "family_quadrature": self.family_quadrature}
+        out = {"dim": self.dim}
+        out.update((k, getattr(self, k)) for k in parts_mod.FIELDS)
         if self.family_quadrature == "moments":
             del out["weights"]  # the rule makes its own
         rule = self.family_rule
@@ -306,6 +285,16 @@ class BasisSpec:
                 bool(bond), vc, vc_boundary, vc_solver, vc_exclude,
                 vc_tolerance),
             method=method), dim)
+
+
+def _keyword(part, field):
+    return property(lambda self: getattr(getattr(self.parts, part), field),
+                    doc="``{}.{}`` of the parts".format(part, field))
+
+
+# the keywords read back from the parts (spec.vc, spec.shape, ...)
+for _key, (_part, _field) in parts_mod.FIELDS.items():
+    setattr(BasisSpec, _key, _keyword(_part, _field))
 
 
 @dataclasses.dataclass
@@ -596,7 +585,8 @@ def build(particles, spec, area_vectors=None, distributed=None):
     fam = make_families(particles, spec, distributed)
     timings["families"] = time.perf_counter() - t0
     if spec.vc_solver == "local":  # no global system, on ranks neither
-        vc_solve = local_vc.local_solver(particles, distributed)
+        vc_solve = (local_vc.local_solver(particles) if distributed is None
+                    else distributed.local_vc_solver())
     else:
         vc_solve = (vc_correction if distributed is None
                     else distributed.vc_correction)

@@ -222,43 +222,25 @@ def _corrected(parts, Qs, B, shares, volumes, x):
     return Gc
 
 
-def local_solver(particles, distributed=None):
+def local_solver(particles):
     """The ``vc_solve`` of a basis built with ``vc_solver="local"``:
     :func:`local_vc_correction` with the shares of ``particles``' mesh
-    (vertex particles of a linear mesh), or on a rank of ``distributed``
-    (a :class:`~skfem_pg.distributed.Partition`) those of its owned
-    masters — no communication but the report's residual sum."""
-    if distributed is None:
-        mesh, x = particles.mesh, particles.x
-        if mesh is None or particles.kind != "vertices":
-            raise ValueError(
-                "vc_solver='local' takes its family shares from the "
-                "collocation mesh: vertex particles of a linear mesh "
-                "(Particles.from_mesh), not {}".format(
-                    "particles without a mesh" if mesh is None else
-                    "{} particles".format(particles.kind)))
-        S = []  # built at the first call: inside the correction's timing
-
-        def shares(masters, mem, mask):
-            if not S:
-                S.extend(smoothed_gradients(mesh, particles.elements))
-            return family_shares(S, masters, mem, mask, x)
-        return functools.partial(local_vc_correction, shares=shares)
-    from ..distributed.comm import raise_together
-    part = distributed
-    glob = part.particles
-    S = []
-    A = part.area_vectors()
+    (vertex particles of a linear mesh).  A rank's basis takes its
+    partition's (:meth:`skfem_pg.distributed.Partition.local_vc_solver`:
+    the shares of its owned masters, no communication but the report's
+    residual sum)."""
+    mesh, x = particles.mesh, particles.x
+    if mesh is None or particles.kind != "vertices":
+        raise ValueError(
+            "vc_solver='local' takes its family shares from the "
+            "collocation mesh: vertex particles of a linear mesh "
+            "(Particles.from_mesh), not {}".format(
+                "particles without a mesh" if mesh is None else
+                "{} particles".format(particles.kind)))
+    S = []  # built at the first call: inside the correction's timing
 
     def shares(masters, mem, mask):
         if not S:
-            S.extend(smoothed_gradients(part.mesh, glob.elements,
-                                        rows=part.owned))
-        return family_shares(S, part.local[masters], part.local[mem], mask,
-                             glob.x)
-
-    def complete(sums):
-        return part.sum_particles(sums) - A.T, glob.active
-    return functools.partial(
-        local_vc_correction, shares=shares, complete=complete,
-        together=functools.partial(raise_together, part.comm))
+            S.extend(smoothed_gradients(mesh, particles.elements))
+        return family_shares(S, masters, mem, mask, x)
+    return functools.partial(local_vc_correction, shares=shares)

@@ -5,20 +5,16 @@ scikit-fem makes a basis of parts (``CellBasis(mesh, element, mapping,
 quadrature)``); a family basis has five, held by
 :class:`~skfem_pg.discretization.builder.BasisSpec`:
 
-==================  ==================================  ====================
-part                chooses                             keywords
-==================  ==================================  ====================
-:class:`FamilyRule` which particles form each family     ``families``
-:class:`Shape`      the Taylor expansion (3.32) and its  ``shape``,
-                    bond weights (3.33)                  ``weight_exponent``
-:class:`Quadrature` where a family integrates, with      ``family_quadrature``,
-                    which weights                        ``weights``
-:class:`Correction` bond (5.55) and VC corrections       ``bond``, ``vc``,
-                                                         ``vc_*``
-:class:`Method`     Bubnov– or Petrov–Galerkin, the      ``method``,
-                    test derivatives                     ``test_shape``,
-                                                         ``lme_mu``
-==================  ==================================  ====================
+* :class:`FamilyRule` — which particles form each family (``families``);
+* :class:`Shape` — the Taylor expansion (3.32) and its bond weights
+  (3.33) (``shape``, ``weight_exponent``);
+* :class:`Quadrature` — where a family integrates, with which weights
+  (``family_quadrature``, ``weights``);
+* :class:`Correction` — bond (5.55) and VC corrections (``bond``,
+  ``vc``, ``vc_boundary``, ``vc_solver``, ``vc_exclude``,
+  ``vc_tolerance``);
+* :class:`Method` — Bubnov– or Petrov–Galerkin and the test derivatives
+  (``method``, ``test_shape``, ``lme_mu``).
 
 A part checks its own values when it is made; :meth:`Part.conflict` says
 what it needs of the others and :meth:`Part.refusal` which
@@ -63,14 +59,19 @@ VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
 #: (:data:`skfem_pg.discretization.families.RULES`)
 FAMILY_RULES = ("mesh", "nearest", "horizon")
 BOUNDARIES = ("min-norm", "p", "s", "sn")
-#: keyword -> the part holding it
-KEYWORDS = {"families": "family_rule", "shape": "shape",
-            "weight_exponent": "shape", "weights": "quadrature",
-            "family_quadrature": "quadrature", "bond": "correction",
-            "vc": "correction", "vc_boundary": "correction",
-            "vc_solver": "correction", "vc_exclude": "correction",
-            "vc_tolerance": "correction", "method": "method",
-            "test_shape": "method", "lme_mu": "method"}
+#: keyword of :class:`~skfem_pg.FamilyBasis` -> (the part, its field)
+FIELDS = {"shape": ("shape", "name"),
+          "weight_exponent": ("shape", "weight_exponent"),
+          "weights": ("quadrature", "weights"),
+          "family_quadrature": ("quadrature", "rule"),
+          "bond": ("correction", "bond"), "vc": ("correction", "vc"),
+          "vc_boundary": ("correction", "boundary"),
+          "vc_solver": ("correction", "solver"),
+          "vc_exclude": ("correction", "exclude"),
+          "vc_tolerance": ("correction", "tolerance"),
+          "method": ("method", "name"),
+          "test_shape": ("method", "test_shape"),
+          "lme_mu": ("method", "lme_mu")}
 
 
 class Part:
@@ -442,6 +443,6 @@ def min_members(parts, dim):
 
 
 __all__ = ["BOUNDARIES", "CAPABILITIES", "Correction", "FAMILY_RULES",
-           "FamilyRule", "KEYWORDS", "METHODS", "Method", "NotBuilt", "Part",
+           "FamilyRule", "FIELDS", "METHODS", "Method", "NotBuilt", "Part",
            "Parts", "Quadrature", "Shape", "VC_VARIANTS",
            "check", "conflict", "min_members", "refusal", "require"]

@@ -25,41 +25,16 @@ killed at any moment leaves a manifest whose pieces are complete.  Resume
 on the same number of ranks and the same partition (the pieces carry the
 fingerprint of each rank's model: positions of the local particles).
 """
+import copy
 import os
 
 import numpy as np
-import skfem as fem
 
-from ..discretization.layout import is_family_basis
 from ..solvers import explicit as serial
 from ..solvers.checkpoint import Every, atomic_savez, npz_path
 from ..solvers.dynamics import Trajectory
-from ..solvers.mass import lumped_mass as serial_lumped_mass, row_sums
+from ..solvers.problem import Problem
 from .halo import HaloExchange
-
-
-def lumped_mass(basis, part, rho):
-    """The diagonal mass on the rank's local dofs: a family basis from
-    :meth:`Partition.basis` (:math:`\\rho_0 V^k` per particle: complete
-    as it is) or an FE basis from :meth:`Partition.fe_basis` (the row sums
-    of the rank's cells, summed over the ranks).  ``rho``: a number, or
-    one value per particle / per element of the mesh (serial
-    numbering)."""
-    rho = np.asarray(rho, dtype=float)
-    if is_family_basis(basis):
-        if rho.ndim == 1 and rho.shape[0] == part.n:
-            rho = rho[part.local]
-        return serial_lumped_mass(basis, rho)
-    if rho.ndim == 1 and rho.shape[0] == part.mesh.nelements:
-        rho = rho[part.fe_cells]
-    nc = basis.N // len(part.local)
-    m = HaloExchange(part, nc).complete(row_sums(basis, rho))
-    bad = np.flatnonzero(~(m > 0))
-    if bad.size:
-        raise ValueError("lumped mass {:.3g} at particle {} (serial "
-                         "numbering): row-sum lumping needs linear elements"
-                         .format(m[bad[0]], part.local[bad[0] // nc]))
-    return m
 
 
 class RankCheckpoints(Every):
@@ -113,12 +88,16 @@ def resume_piece(path, part):
     return "{}.rank{}.step{}.npz".format(stem, part.rank, step)
 
 
-def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
-                       u0=None, v0=None, dt=None, wall=None, callback=None,
-                       checkpoint=None, resume=None, controls=None, **kw):
+def central_difference(model, part, m=None, t_end=None, f_ext=None, D=None,
+                       u_D=None, u0=None, v0=None, dt=None, wall=None,
+                       callback=None, checkpoint=None, resume=None,
+                       controls=None, **kw):
     r"""Central differences (:func:`skfem_pg.solvers.central_difference`)
     for a model on this rank's local basis (:meth:`Partition.basis` or
     :meth:`Partition.fe_basis`), collectively on all ranks of ``part``.
+    ``model``: the model, or a :class:`~skfem_pg.solvers.problem.Problem`
+    of it (then ``t_end`` by keyword) whose vectors are serial and whose
+    mass is local.
 
     ``m`` is the local lumped mass (:func:`lumped_mass`); ``f_ext``,
     ``u_D`` (vectors or callables of the time), ``u0``, ``v0`` and the
@@ -132,6 +111,9 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
     ``x``, ``v``, ``a`` in the serial numbering on every rank; the
     energies are those of the whole body.
     """
+    problem = Problem.of(model, "central_difference", f_ext=f_ext, D=D,
+                         u_D=u_D, wall=wall, m=m)
+    model, D = problem.model, problem.D
     n_u = model.n_u
     if model.N != n_u:
         raise NotImplementedError(
@@ -163,11 +145,12 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
         mask = np.zeros(N, dtype=bool)
         mask[as_dofs(D, N, "Dirichlet dofs (serial numbering)")] = True
         D = np.flatnonzero(mask[lsd])
-    walls = [] if wall is None else (list(wall) if isinstance(
-        wall, (list, tuple)) else [wall])
-    for w in walls:  # the serial default tolerance: of the whole body
+    walls = []
+    for w in problem.walls:  # the serial default tolerance: of the whole
+        w = copy.copy(w)     # body (on copies: the caller's walls stay)
         if w.tol is None:
             w.tol = 1e-9 * max(np.ptp(part.particles.x[w.axis]), 1e-300)
+        walls.append(w)
 
     def gather(x):
         return gather_owned(part, x, nc)
@@ -182,11 +165,13 @@ def central_difference(model, part, m, t_end, f_ext=None, D=None, u_D=None,
         every = RankCheckpoints(every, part)
     if resume is not None:
         resume = resume_piece(resume, part)
+    on_rank = Problem(model, f_ext=local(problem.f_ext, "f_ext"), D=D,
+                      u_D=local(problem.u_D, "u_D"), walls=walls,
+                      mass=problem.mass)
     traj = serial.central_difference(
-        model, m, t_end, f_ext=local(f_ext, "f_ext"), D=D,
-        u_D=local(u_D, "u_D"), u0=local(u0, "u0"), v0=local(v0, "v0"),
-        dt=dt, wall=walls or None, callback=cb, checkpoint=every,
-        resume=resume, controls=controls, exchange=ex, **kw)
+        on_rank, t_end=t_end, u0=local(u0, "u0"), v0=local(v0, "v0"),
+        dt=dt, callback=cb, checkpoint=every, resume=resume,
+        controls=controls, exchange=ex, **kw)
     traj.times["messages"] = ex.messages
     return Trajectory(gather(traj.x), gather(traj.v), gather(traj.a),
                       traj.t, traj.history, traj.steps, traj.times)
@@ -202,31 +187,3 @@ def gather_owned(part, x, nc):
     for o, p in zip(owned, parts):
         out.reshape(-1, nc)[o] = p.reshape(-1, nc)
     return out
-
-
-def fe_basis(part, element):
-    """This rank's FE basis for a run on ranks: ``element`` (linear:
-    T1, Q1, O1, H1, vectorial) on the partition's FE cells that the rank
-    assembles, on a mesh of its local vertices (owned, then the other
-    vertices of its cells), so that the dofs are the local ones of
-    :class:`HaloExchange`.  Sets ``part.local``."""
-    mesh, cells = part.mesh, part.fe_cells
-    if len(cells) == 0:
-        raise ValueError("rank {} assembles no FE cell (the partition's "
-                         "fe_elements: a cell goes to the owner of its first "
-                         "vertex)".format(part.rank))
-    halo = np.setdiff1d(mesh.t[:, cells], part.owned)
-    local = np.concatenate([part.owned, halo])
-    index = np.full(part.n, -1, dtype=np.int64)
-    index[local] = np.arange(len(local))
-    sub = type(mesh)(mesh.p[:, local], index[mesh.t[:, cells]])
-    basis = fem.Basis(sub, element)
-    nc = basis.N // max(len(local), 1)
-    if nc * len(local) != basis.N:
-        raise ValueError("fe_basis takes linear elements (one dof per "
-                         "vertex and component): {} has {} dofs on {} "
-                         "vertices".format(type(element).__name__, basis.N,
-                                           len(local)))
-    part.local = local
-    part.ncomp = nc
-    return basis

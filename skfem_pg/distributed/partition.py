@@ -58,7 +58,7 @@ from ..discretization.families import Families
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
 from .comm import as_mpi, petsc, raise_together
-from .vc import vc_correction
+from .vc import local_solver, vc_correction
 
 #: cell rings around the owned particles from which their families are
 #: built: one for the family, three for from_mesh's enlargement
@@ -402,11 +402,33 @@ class Partition:
         return local
 
     def fe_basis(self, element):
-        """This rank's scikit-fem basis of ``element`` on its FE cells, on
-        a mesh of its local vertices (an FE model run on ranks:
-        :func:`skfem_pg.distributed.explicit.fe_basis`)."""
-        from .explicit import fe_basis
-        return fe_basis(self, element)
+        """This rank's scikit-fem basis of ``element`` (linear: T1, Q1,
+        O1, H1, vectorial) on the partition's FE cells that the rank
+        assembles, on a mesh of its local vertices (owned, then the other
+        vertices of its cells), so that the dofs are the local ones of
+        :class:`~skfem_pg.distributed.halo.HaloExchange` (an FE model run
+        on ranks).  Like :meth:`basis`, sets :attr:`local` (and
+        ``ncomp``): the partition holds the last basis' numbering."""
+        mesh, cells = self.mesh, self.fe_cells
+        if len(cells) == 0:
+            raise ValueError("rank {} assembles no FE cell (the partition's "
+                             "fe_elements: a cell goes to the owner of its "
+                             "first vertex)".format(self.rank))
+        halo = np.setdiff1d(mesh.t[:, cells], self.owned)
+        local = np.concatenate([self.owned, halo])
+        index = np.full(self.n, -1, dtype=np.int64)
+        index[local] = np.arange(len(local))
+        sub = type(mesh)(mesh.p[:, local], index[mesh.t[:, cells]])
+        basis = fem.Basis(sub, element)
+        nc = basis.N // max(len(local), 1)
+        if nc * len(local) != basis.N:
+            raise ValueError("fe_basis takes linear elements (one dof per "
+                             "vertex and component): {} has {} dofs on {} "
+                             "vertices".format(type(element).__name__,
+                                               basis.N, len(local)))
+        self.local = local
+        self.ncomp = nc
+        return basis
 
     # -- FE cells of a coupled model ------------------------------------------
     def fe_assemble(self, form, element, **kwargs):
@@ -432,6 +454,14 @@ class Partition:
         return np.asarray(A)[loc]
 
     # -- the VC correction, assembled over ranks -----------------------------
+    def sum_ranks(self, a):
+        """The array ``a`` (same shape on every rank) summed over the
+        ranks, on every rank."""
+        from mpi4py import MPI
+        out = np.array(a)
+        self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
+        return out
+
     def sum_particles(self, r):
         """Per-particle arrays of the local particles ``(n_local, ...)``
         summed over all ranks into ``(n, ...)`` on every rank."""
@@ -445,6 +475,11 @@ class Partition:
         """:func:`skfem_pg.distributed.vc.vc_correction` on this partition
         (what a rank's :class:`~skfem_pg.FamilyBasis` calls)."""
         return vc_correction(self, *args, **kwargs)
+
+    def local_vc_solver(self):
+        """The ``vc_solve`` of a rank's basis with ``vc_solver="local"``
+        (:func:`skfem_pg.distributed.vc.local_solver`)."""
+        return local_solver(self)
 
     # -- PPG1: test derivatives from the halo's families ---------------------
     def reverse_master_derivatives(self, Gt, fam):

@@ -25,6 +25,7 @@ from ..dofs import as_dofs
 from ..solvers.result import Result
 from ..progress import Echo
 from ..solvers.controls import NewtonControls
+from ..solvers.problem import Problem, Solution
 from ..solvers.static import (LinearSolveFailed, load_stepping,
                               newton_iterations)
 
@@ -111,9 +112,11 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
     :func:`~skfem_pg.solvers.static.newton_iterations`) on PETSc vectors
     and Krylov solves (:class:`PetscAlgebra`).
 
-    ``model`` is a displacement model (e.g.
+    ``model`` is a :class:`~skfem_pg.solvers.problem.Problem` or a
+    displacement model (e.g.
     :class:`~skfem_pg.formulations.Hyperelastic`) on the rank's local
-    basis (:meth:`Partition.basis`); ``f_ext`` (at load factor 1) is a
+    basis (:meth:`Partition.basis`); ``f_ext`` (the problem's or the
+    keyword) (at load factor 1) is a
     serial vector, ``D`` serial dofs, ``u_D`` a serial vector at load
     factor 1 (scaled) or a callable ``u_D(t)`` returning it at load
     factor ``t`` (a rotation), as in the serial solver.
@@ -131,12 +134,16 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
     solve diverges (an indefinite tangent far from equilibrium) is
     halved, as in the serial solver.
 
-    Returns ``(u, history)`` like :func:`skfem_pg.solvers.newton`: ``u``
+    Returns a :class:`~skfem_pg.solvers.problem.Solution` ``(x,
+    history)`` like :func:`skfem_pg.solvers.newton`: ``x``
     in the serial numbering on every rank, ``history`` one dict per
     converged step (load, residual norms, increment energies, KSP
     iterations, minimum J, seconds).
     """
     opts = NewtonControls.of(controls, defaults=DISTRIBUTED_DEFAULTS, **kw)
+    problem = Problem.of(model, "newton", f_ext=f_ext, D=D, u_D=u_D)
+    model, f_ext, D, u_D = problem.model, problem.f_ext, problem.D, \
+        problem.u_D
     if opts.reuse:
         raise NotImplementedError(
             "reuse=True (modified Newton with kept factors) is serial: the "
@@ -171,9 +178,9 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
         out[2]["krylov"] = algebra.krylov[n0:]
         return out
 
-    return load_stepping(model, step, algebra, pt.empty_vector(part), 0.0,
-                         1.0 / opts.steps, opts,
-                         echo=Echo(opts.verbose if part.rank == 0 else False))
+    return Solution(*load_stepping(
+        model, step, algebra, pt.empty_vector(part), 0.0, 1.0 / opts.steps,
+        opts, echo=Echo(opts.verbose if part.rank == 0 else False)))
 
 
 class PetscAlgebra:

@@ -22,6 +22,7 @@ Krylov tolerance.
 families and solves on rank 0 (the serial code) or, with
 ``vc_solver="petsc"``, by :func:`solve_pinned` on all ranks.
 """
+import functools
 import time
 
 import numpy as np
@@ -29,7 +30,9 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from . import petsc as pt
-from .comm import mpi, petsc
+from .comm import mpi, petsc, raise_together
+from ..discretization.local_vc import (family_shares, local_vc_correction,
+                                       smoothed_gradients)
 from ..discretization.corrections import (
     AMG_VC_LIMIT_3D, VCReport, solve_pinned_lu, anchor_particles,
     linear_fields, scalar_constraint_matrix, vc_apply, vc_parts,
@@ -251,3 +254,27 @@ def _finish(part, parts, Qs, alpha, r0, grouped, variant, solver, nf, its,
         iterations=its, seconds=time.perf_counter() - t0,
         boundary=boundary, particle_residuals=per[part.local])
     return (Gc if grouped else Gc[0]), rep
+
+
+def local_solver(part):
+    """The ``vc_solve`` of a rank's basis with ``vc_solver="local"``
+    (:func:`skfem_pg.discretization.local_vc.local_vc_correction`): the
+    shares of the partition's owned masters on the replicated mesh, the
+    residual summed over the ranks, an error of one rank's families
+    raised on every rank — no other communication."""
+    glob = part.particles
+    S = []
+    A = part.area_vectors()
+
+    def shares(masters, mem, mask):
+        if not S:
+            S.extend(smoothed_gradients(part.mesh, glob.elements,
+                                        rows=part.owned))
+        return family_shares(S, part.local[masters], part.local[mem], mask,
+                             glob.x)
+
+    def complete(sums):
+        return part.sum_particles(sums) - A.T, glob.active
+    return functools.partial(
+        local_vc_correction, shares=shares, complete=complete,
+        together=functools.partial(raise_together, part.comm))

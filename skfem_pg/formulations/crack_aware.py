@@ -18,7 +18,8 @@ master):
   integration points :math:`(k, j)` it holds — master :math:`k` and
   member :math:`j` both vertices of the cell — have failed
   (:mod:`~skfem_pg.materials.damage`).  Pieces are cells connected
-  through facets (:func:`separate`): where two pieces touch at a vertex
+  through facets (:func:`~skfem_pg.discretization.cracks.separate`, the
+  crack's geometry as functions of the mesh): where two pieces touch at a vertex
   only (a pinch, which the vertex' family would bridge; it makes the VC
   system near-singular — measured: derivatives of 1e14 on the two-hole
   plate), the cells of the smaller piece at that vertex fail too; a cell
@@ -66,7 +67,8 @@ master):
 
 On MPI ranks (a basis from :meth:`Partition.basis
 <skfem_pg.distributed.Partition.basis>`) the failed points of each cell
-are counted over the ranks (:func:`failure_counts`, one reduction), so
+are counted over the ranks
+(:func:`~skfem_pg.discretization.cracks.failure_counts`, one reduction), so
 that every rank fails the same cells, and each rank rebuilds its part of
 the basis on the intact cells, on the local particles of the first one
 (:meth:`~skfem_pg.distributed.Partition.restricted`): the dofs, the
@@ -82,19 +84,16 @@ before they use it.
 import time
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from ..discretization.assembly import assemble
 from ..discretization.basis import FamilyBasis
-from ..discretization.elementwise import Elements
+from ..discretization.cracks import failure_counts, pieces, separate
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
 from ..threads import kernel
-from ..discretization.shape.least_squares import mls1_master_hessians
 from .displacement import Hyperelastic, internal_force, material_tangent
 from .history import History
-from .stabilized import U1SIG, second_moment
+from .stabilized import U1SIG
 from .updated_lagrange import carry_points, point_keys
 
 
@@ -109,85 +108,6 @@ def cell_failure(basis, cells, failed, keys=None):
     return bad / np.maximum(held, 1)
 
 
-def failure_counts(keys, n, cells, failed):
-    """``(failed, held)``: per cell, how many of the points ``keys``
-    (:math:`k n + j`, particles numbered ``0..n-1`` as the vertices of
-    ``cells``) it holds, and how many of them have ``failed`` (counts:
-    on MPI ranks they are summed over the ranks)."""
-    keys = np.asarray(keys)
-    if keys.size == 0:  # a rank without points
-        return (np.zeros(cells.shape[1], int),) * 2
-    order = np.argsort(keys)
-    sk = keys[order]
-    q = (cells[:, None, :] * n + cells[None, :, :]).reshape(-1,
-                                                          cells.shape[1])
-    pos = np.minimum(np.searchsorted(sk, q), len(sk) - 1)
-    hit = sk[pos] == q
-    bad = hit & np.asarray(failed, bool).ravel()[order[pos]]
-    return bad.sum(axis=0), hit.sum(axis=0)
-
-
-def pieces(mesh, intact):
-    """The pieces of the ``intact`` cells of ``mesh`` (cells sharing a
-    facet are connected): ``(label per intact cell, cells per piece)``."""
-    idx = np.flatnonzero(intact)
-    if idx.size == 0:
-        return np.zeros(0, int), np.zeros(0, int)
-    a, b = mesh.f2t
-    both = (b >= 0) & intact[a] & intact[np.maximum(b, 0)]
-    local = np.full(intact.shape[0], -1)
-    local[idx] = np.arange(idx.size)
-    G = sp.csr_matrix((np.ones(both.sum()), (local[a[both]],
-                                             local[b[both]])),
-                      shape=(idx.size, idx.size))
-    _, label = connected_components(G, directed=False)
-    return label, np.bincount(label)
-
-
-def separate(mesh, intact, min_piece):
-    """The intact cells after the pieces are made clean: a vertex whose
-    cells belong to more than one piece (two pieces touching at a vertex,
-    a pinch that a family would bridge) keeps the cells of its largest
-    piece only; a cell with two or more vertices that the crack has left
-    with this cell alone (a flap, held by one facet or less) goes too;
-    pieces with fewer than ``min_piece`` vertices go (debris).  Repeated
-    until nothing changes (at most once per cell)."""
-    intact = intact.copy()
-    nv = mesh.p.shape[1]
-    cells_at = np.bincount(mesh.t.ravel(), minlength=nv)
-    for _ in range(intact.size + 1):
-        idx = np.flatnonzero(intact)
-        label, size = pieces(mesh, intact)
-        t = mesh.t[:, idx]
-        left = np.bincount(t.ravel(), minlength=nv)
-        alone = (left == 1) & (cells_at > 1)  # the crack took the others
-        # vertices per piece, and the pieces at each vertex
-        at = sp.csr_matrix((np.ones(t.size, bool), (t.ravel(), np.tile(
-            label, t.shape[0]))), shape=(nv, size.size))
-        at.sum_duplicates()
-        drop = alone[t].sum(axis=0) >= 2  # flaps
-        verts = np.diff(at.tocsc().indptr)
-        drop |= verts[label] < min_piece
-        pinch = np.flatnonzero(np.diff(at.indptr) > 1)
-        if pinch.size:
-            # at each pinch the cells of all but its largest piece go
-            rows = at[pinch].tocoo()
-            best = np.zeros(pinch.size, int)
-            key = size[rows.col] * (size.size + 1) + rows.col
-            order = np.lexsort((key, rows.row))
-            last = np.r_[np.diff(rows.row[order]) != 0, True]
-            best[rows.row[order][last]] = rows.col[order][last]
-            keep_piece = np.full(nv, -1)
-            keep_piece[pinch] = best
-            touches = keep_piece[t]  # (corners, cells)
-            drop |= np.any((touches >= 0) & (touches != label[None]),
-                           axis=0)
-        if not drop.any():
-            return intact
-        intact[idx[drop]] = False
-    return intact
-
-
 class _CrackHistory(History):
     """The material's history plus the crack (intact cells, the update's
     :math:`u_c`, :math:`F_c` and released energy) in checkpoints: a
@@ -200,13 +120,7 @@ class _CrackHistory(History):
 
     def save(self):
         out = super().save() or {}
-        m = self._model
-        out["crack_intact"] = m.intact.astype(float)
-        out["crack_u_c"] = m.u_c.copy()
-        out["crack_released"] = np.array(m.released_at_updates)
-        out["crack_n_failed"] = np.array(float(m._n_failed))
-        if m.F_c is not None:
-            out["crack_F_c"] = np.array(m.F_c)
+        out.update(self._model.crack_state())
         return out
 
     def mismatch(self, saved):
@@ -226,7 +140,7 @@ class _CrackHistory(History):
         crack = {k: saved.pop(k) for k in list(saved)
                  if k.startswith("crack_")}
         if crack:
-            self._model._restore(crack)
+            self._model.restore_crack(crack)
         n = self._model._n_points()
         for k, v in saved.items():
             if np.shape(v)[-1] != n:
@@ -303,7 +217,7 @@ class _Crack:
     def _total(self, count):
         """A count summed over the ranks (as it is serially)."""
         return count if self._part is None else \
-            self._part.comm.allreduce(count)
+            int(self._part.sum_ranks(np.array([count]))[0])
 
     # -- the crack ------------------------------------------------------
     def cells_to_fail(self, failed):
@@ -317,10 +231,7 @@ class _Crack:
             keys = self._local[k] * n + self._local[j]
         bad, held = failure_counts(keys, n, mesh.t[:, idx], failed)
         if self._part is not None:  # every point lives on one rank
-            from mpi4py import MPI
-            both = np.stack([bad, held])
-            self._part.comm.Allreduce(MPI.IN_PLACE, both, op=MPI.SUM)
-            bad, held = both
+            bad, held = self._part.sum_ranks(np.stack([bad, held]))
         share = bad / np.maximum(held, 1)
         fail = np.zeros_like(self.intact)
         fail[idx[share >= self.fraction - 1e-12]] = True
@@ -392,8 +303,21 @@ class _Crack:
                 "enlarged beyond its piece of intact cells)".format(
                     describe_particle(m, mesh.p[:, m])))
 
-    def _restore(self, crack):
-        """Rebuild the basis on a checkpoint's intact cells."""
+    def crack_state(self):
+        """The crack as checkpoint arrays (``crack_*``): the intact cells,
+        :math:`u_c`, :math:`F_c`, the energy released at updates and the
+        count of failed points."""
+        out = {"crack_intact": self.intact.astype(float),
+               "crack_u_c": self.u_c.copy(),
+               "crack_released": np.array(self.released_at_updates),
+               "crack_n_failed": np.array(float(self._n_failed))}
+        if self.F_c is not None:
+            out["crack_F_c"] = np.array(self.F_c)
+        return out
+
+    def restore_crack(self, crack):
+        """The crack of a checkpoint (:meth:`crack_state`): the basis
+        rebuilt on its intact cells."""
         intact = np.asarray(crack["crack_intact"]) > 0.5
         if self.updates or not intact.all():
             self._set_basis(self._basis_on(intact))
@@ -547,17 +471,7 @@ class CrackAwareU1SIG(_Crack, U1SIG):
         return F1[..., idx]
 
     def _set_basis(self, new):
-        """Everything U1SIG derives from its basis, on ``new``."""
-        p, fam = new.particles, new.families
-        self.u1 = new
-        self._E1 = Elements(new)
-        self._master_flat = fam.offsets[:-1]
-        self._G0 = None
-        self.hessians = mls1_master_hessians(p.x, p.volumes, fam,
-                                             n=new.weight_exponent)
-        self.M2 = second_moment(p.volumes[fam.masters], p.dim)
-        self._Ks, self._At, self._frozen = (None, None), (None, None), \
-            (None, None)
+        self._bind(new)  # U1SIG's own binding of its basis
 
     def _n_points(self):
         return len(self.u1.families.masters)

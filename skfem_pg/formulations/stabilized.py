@@ -169,10 +169,17 @@ class _MasterModel(Hyperelastic):
     def __init__(self, basis, u1, material):
         self.mu0, self.K0 = _moduli(material, self.name)
         super().__init__(basis, material)
+        self._F_committed = None
+        self._bind(u1)
+
+    def _bind(self, u1):
+        """Derive what the model keeps of the under-integrated basis
+        ``u1`` (a crack-aware model binds the basis of its intact cells
+        after each rebuild, :mod:`~skfem_pg.formulations.crack_aware`)."""
         self.u1 = u1
         self._E1 = Elements(u1)
         self._master_flat = u1.families.offsets[:-1]
-        self._F_committed = None
+        self._G0 = None  # the masters' derivatives, built when asked
         self._frozen = (None, None)  # (key, (mu~, K~, Cp_inv, F))
 
     def master_F(self, u):
@@ -190,7 +197,7 @@ class _MasterModel(Hyperelastic):
     def _master_gradients(self):
         """Per size group of ``u1``: ``(group, G0)`` with ``G0`` ``(nf_b,
         m, d)`` the masters' derivatives :math:`G^{kki}` (cached)."""
-        if getattr(self, "_G0", None) is None:
+        if self._G0 is None:
             self._G0 = [(g, np.ascontiguousarray(G[:, 0]))
                         for g, G in zip(self.u1.layout,
                                         self.u1.grouped_gradients())]
@@ -366,8 +373,10 @@ class U1SIG(_MasterModel):
     def __init__(self, basis, material):
         u1 = under_integrated(basis)
         super().__init__(u1, u1, material)
-        p = u1.particles
-        fam = u1.families
+
+    def _bind(self, u1):
+        super()._bind(u1)
+        p, fam = u1.particles, u1.families
         self.hessians = mls1_master_hessians(p.x, p.volumes, fam,
                                              n=u1.weight_exponent)
         self.M2 = second_moment(p.volumes[fam.masters], p.dim)

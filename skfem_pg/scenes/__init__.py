@@ -2,7 +2,7 @@
 FE overkill references (``reference``), node sets from the ``.geo``
 sources of the repository's ``meshes/`` (``meshing``).  VTU output is
 :mod:`skfem_pg.io`."""
-from .scene import Scene, Result, inside, centroid_tree
+from .scene import Scene, Result, Setup, inside, centroid_tree
 
-__all__ = ["Scene", "Result", "inside",
+__all__ = ["Scene", "Result", "Setup", "inside",
            "centroid_tree"]

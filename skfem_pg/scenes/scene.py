@@ -39,7 +39,7 @@ the reaction forces (:meth:`Result.reaction`).
 from __future__ import annotations
 
 import hashlib
-from typing import Sequence
+from typing import Any, NamedTuple, Sequence
 import time
 
 import numpy as np
@@ -56,6 +56,7 @@ from ..formulations.updated_lagrange import UpdatedLagrange
 from ..keys import exact
 from ..naming import fe_method, formulation_of, frame_of, parse
 from ..solvers import newton
+from ..solvers.problem import Problem
 from ..solvers.result import Result
 from .. import distributed, registry
 from ..distributed.solve import DistributedResult
@@ -361,10 +362,11 @@ class Scene:
         if comm is not None:
             return self._solve_distributed(scheme, comm, verbose, tangent,
                                            tol, solver, basis_kwargs)
-        basis, model, f, D, u_D, t_pre = self.setup(
-            scheme, mesh, tangent, **basis_kwargs)
-        x, hist = newton(model, f, D=D, u_D=u_D, steps=self.steps,
-                         solver=solver, verbose=verbose, tol=tol)
+        setup = self.setup(scheme, mesh, tangent, **basis_kwargs)
+        basis, model, t_pre = setup.basis, setup.model, setup.seconds
+        f = setup.f_ext
+        x, hist = newton(setup.problem, steps=self.steps, solver=solver,
+                         verbose=verbose, tol=tol)
         times = {"preprocess": t_pre,
                  "assemble": sum(h["t_assemble"] for h in hist),
                  "solve": sum(h["t_linear"] for h in hist)}
@@ -418,9 +420,11 @@ class Scene:
 
     def setup(self, scheme="PG", mesh=None, tangent="consistent",
               **basis_kwargs):
-        """What :meth:`solve` hands Newton's method: ``(basis, model,
-        f_ext, D, u_D, seconds)`` for ``scheme`` (as in :meth:`solve`);
-        ``u_D(t)`` gives the prescribed values at load factor ``t``.  A
+        """What :meth:`solve` hands Newton's method for ``scheme`` (as in
+        :meth:`solve`): a :class:`Setup` ``(basis, model, f_ext, D, u_D,
+        seconds)`` whose ``problem`` is the
+        :class:`~skfem_pg.solvers.problem.Problem`; ``u_D(t)`` gives the
+        prescribed values at load factor ``t``.  A
         name in the updated Lagrangian frame (``"... Unl UL"``) gives an
         :class:`~skfem_pg.formulations.UpdatedLagrange` model, rebuilt
         every ``params["ul_every"]`` converged steps (default 1)."""
@@ -451,8 +455,8 @@ class Scene:
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()),
                     model.load())
-            return basis, model, f, np.zeros(0, dtype=np.int64), None, \
-                time.perf_counter() - t0
+            return Setup(basis, model, f, np.zeros(0, dtype=np.int64), None,
+                         time.perf_counter() - t0)
         elif method in registry.fe_names():
             if basis_kwargs:
                 raise ValueError(
@@ -470,7 +474,7 @@ class Scene:
             raise ValueError("unknown method {!r}: 'PG' or one of {}".format(
                 method, ", ".join(registry.fe_names())))
         D, u_D = self._dirichlet(basis)
-        return basis, model, f, D, u_D, time.perf_counter() - t0
+        return Setup(basis, model, f, D, u_D, time.perf_counter() - t0)
 
     def evaluate(self, basis, u, particles=None):
         """Displacements at the probe points: at the particle there for
@@ -511,6 +515,24 @@ def _scheme(scheme, basis_kwargs):
                              method, ", ".join(registry.fe_names()),
                              err)) from None
     return "PG", formulation_of(method), {**kw, **basis_kwargs}
+
+
+class Setup(NamedTuple):
+    """What :meth:`Scene.setup` returns; unpacks as ``basis, model, f_ext,
+    D, u_D, seconds`` (``seconds``: the time spent making them)."""
+
+    basis: Any
+    model: Any
+    f_ext: np.ndarray
+    D: np.ndarray
+    u_D: Any
+    seconds: float
+
+    @property
+    def problem(self):
+        """The :class:`~skfem_pg.solvers.problem.Problem` the drivers
+        take."""
+        return Problem(self.model, f_ext=self.f_ext, D=self.D, u_D=self.u_D)
 
 
 def centroid_tree(mesh):

@@ -23,13 +23,17 @@ For Newmark's average acceleration (β = 1/4, γ = 1/2) the trapezoidal
 works make the balance exact for a linear problem; for central
 differences it holds to :math:`O(\Delta t^2)` with no drift.
 """
+import contextlib
+import copy
 import json
 import sys
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
+from ..dofs import as_dofs
 from ..errors import FamilyError, ParticleError
 from ..progress import Echo
 from .checkpoint import load as load_checkpoint
@@ -72,7 +76,7 @@ def check_run(n_u, N, m, t_end, dt=None, u0=None, v0=None,
         raise ValueError("the mass must be finite and positive at every "
                          "dof: {} entries are not (first: dof {} = {})"
                          .format(bad.size, bad[0], m[bad[0]]))
-    if not (np.isfinite(t_end) and t_end > 0):
+    if t_end is None or not (np.isfinite(t_end) and t_end > 0):
         raise ValueError("t_end must be a positive time, got {!r}"
                          .format(t_end))
     if dt is None:
@@ -310,12 +314,67 @@ def free_mask(n_u, Dd):
 
 
 def bind_walls(wall, basis, n_u, Dd):
-    """``(walls, candidates)``: ``wall`` (a
-    :class:`~skfem_pg.solvers.RigidWall`, a list of them or ``None``) as a
-    list, and the dofs each may hold (:meth:`RigidWall.bind`)."""
+    """``(walls, candidates)``: copies of ``wall`` (a
+    :class:`~skfem_pg.solvers.RigidWall`, a list of them or ``None``)
+    bound to this run, and the dofs each may hold
+    (:meth:`RigidWall.bind`).  The caller's walls are not changed: a wall
+    without ``tol`` takes its default from each body it meets."""
     walls = [] if wall is None else (list(wall) if isinstance(
         wall, (list, tuple)) else [wall])
+    walls = [copy.copy(w) for w in walls]
     return walls, [w.bind(basis, n_u, Dd) for w in walls]
+
+
+class BoundProblem(NamedTuple):
+    """A :class:`~skfem_pg.solvers.problem.Problem` as a time integration
+    uses it: the model, the mass, the prescribed dofs ``D`` (an array),
+    the ``free`` displacement dofs, ``f_of(t)`` / ``uD_of(t)`` (full
+    vectors) and the walls bound to the run with their candidate dofs."""
+
+    model: object
+    m: np.ndarray
+    D: np.ndarray
+    free: np.ndarray
+    f_of: object
+    uD_of: object
+    walls: list
+    candidates: list
+
+
+def bind_problem(problem, m, bind=bind_walls):
+    """The :class:`BoundProblem` of ``problem`` with the checked mass
+    ``m``; ``bind(walls, basis, n_u, D)`` binds the walls (a collective
+    one on MPI ranks)."""
+    model = problem.model
+    n_u = model.n_u
+    Dd = as_dofs(problem.D, n_u, "Dirichlet (displacement) dofs")
+    f_of, uD_of = time_functions(model, problem.f_ext, problem.u_D)
+    walls, cand = bind(list(problem.walls), model.basis, n_u, Dd)
+    return BoundProblem(model, m, Dd, free_mask(n_u, Dd), f_of, uD_of,
+                        walls, cand)
+
+
+class Timings(dict):
+    """Seconds per phase of a run, as a dict; ``with timings("force"):``
+    adds the seconds of the block to its phase.
+
+    >>> t = Timings(("force",))
+    >>> with t("force"):
+    ...     pass
+    >>> sorted(t), t["force"] >= 0.0
+    (['force'], True)
+    """
+
+    def __init__(self, phases=()):
+        super().__init__(dict.fromkeys(phases, 0.0))
+
+    @contextlib.contextmanager
+    def __call__(self, phase):
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self[phase] = self.get(phase, 0.0) + time.perf_counter() - t0
 
 
 class Recorder:

@@ -43,8 +43,7 @@ import time
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model, require_model
-from ..dofs import as_dofs
+from ..formulations.protocol import Model
 from ..materials import ReturnMapError
 from ..materials.hyperelastic import inverse_and_det
 from .contact import hold_initial
@@ -52,9 +51,10 @@ from .checkpoint import Every
 from .exchange import SerialExchange
 from .controls import ExplicitControls
 from .dynamics import (DynamicsError, EnergyBalance, MAX_STEPS, Progress,
-                       Recorder, Trajectory, bind_walls, check_run, commit,
-                       free_mask, resume_run, save_run, stored_energy,
-                       time_functions)
+                       Recorder, Timings, Trajectory, bind_problem,
+                       bind_walls, check_run, commit, resume_run, save_run,
+                       stored_energy)
+from .problem import Problem
 from ..discretization.particles import inverted_cells
 
 
@@ -254,7 +254,8 @@ def stable_time_step(model, m, x=None, free=None, safety=0.8,
     return safety * 2.0 / w
 
 
-def central_difference(model: Model, m: ArrayLike, t_end: float,
+def central_difference(model: Model | Problem, m: ArrayLike | None = None,
+                       t_end: float | None = None,
                        f_ext: ArrayLike | Callable | None = None, D=None,
                        u_D: ArrayLike | Callable | None = None,
                        u0: ArrayLike | None = None,
@@ -270,10 +271,14 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
     Parameters
     ----------
     model
-        A displacement-only model (Unl, UnlP0, U1SUnl, U1SIG, FE; no global
-        extra fields).
+        A :class:`~skfem_pg.solvers.problem.Problem` (its model, loads,
+        Dirichlet data, walls and mass; then give ``t_end`` by keyword),
+        or a displacement-only model (Unl, UnlP0, U1SUnl, U1SIG, FE; no
+        global extra fields) with the keywords below.
     m
         Diagonal mass per displacement dof (:func:`lumped_mass`).
+    t_end
+        The end time.
     f_ext, u_D
         External forces and prescribed displacements: vectors (constant)
         or callables of the time; ``D`` the prescribed dofs.
@@ -317,10 +322,9 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
         (``output``).
     """
     c = ExplicitControls.of(controls, **kw)
-    safety, estimate_every, output_every = (c.safety, c.estimate_every,
-                                            c.output_every)
-    max_energy_error, verbose = c.max_energy_error, c.verbose
-    model = require_model(model, "central_difference")
+    problem = Problem.of(model, "central_difference", f_ext=f_ext, D=D,
+                         u_D=u_D, wall=wall, m=m)
+    model = problem.model
     n_u = model.n_u
     if model.N != n_u:
         raise ValueError(
@@ -329,152 +333,229 @@ def central_difference(model: Model, m: ArrayLike, t_end: float,
             "it with newmark".format(type(model).__name__,
                                      model.N - n_u, model.N))
     ex = SerialExchange(n_u) if exchange is None else exchange
-    m = check_run(n_u, n_u, m, t_end, dt, u0, v0)
-    Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
-    f_of, uD_of = time_functions(model, f_ext, u_D)
-    walls, cand = _collective(ex, bind_walls, wall, model.basis, n_u, Dd)
+    m = check_run(n_u, n_u, problem.require_mass("central_difference"),
+                  t_end, dt, u0, v0)
+    run = bind_problem(problem, m, bind=lambda *args: _collective(
+        ex, bind_walls, *args))
     u = model.initial() if u0 is None else np.asarray(u0, float).copy()
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
     if u.shape != (n_u,) or v.shape != (n_u,):
         raise ValueError("u0 and v0 need {} entries".format(n_u))
-    u[Dd] = uD_of(0.0)[Dd]
-    free = free_mask(n_u, Dd)
-    inv_m = np.where(free, 1.0 / m, 0.0)
-    times = dict.fromkeys(("force", "commit", "estimate", "contact",
-                           "output"), 0.0)
-    t_start = t0 = time.perf_counter()
-    state = _evaluate(model, u, 0.0, None, v, exchange=ex)
-    fi = ex.complete(model.internal_force(state))
-    times["force"] += time.perf_counter() - t0
-    fe = f_of(0.0)
-    a = inv_m * (fe - fi)
-    held = np.zeros(n_u, dtype=bool)  # dofs a wall holds
-    energy = EnergyBalance(m, v, free, ex.sum(stored_energy(model, state)),
-                           dot=ex.dot)
-    energy.D_c += _collective(ex, hold_initial, walls, cand, u, v, a, m,
-                              held, ex.dot)
-    progress = Progress(t_end, verbose if ex.root else False)
-    out = Recorder(model, energy, free, progress, callback, times,
-                   total=ex.sum)
-    hist = out.hist
-    t, steps = 0.0, 0
+    u[run.D] = run.uD_of(0.0)[run.D]
+    stepper = _CentralDifference(run, c, ex, t_end, dt, callback)
+    stepper.start(u, v, resume)
+    every = Every.of(checkpoint)
+    while stepper.t < t_end * (1 - 1e-12):
+        stepper.advance()
+        if every is not None:
+            stepper.save(every)
+    return stepper.trajectory()
 
-    def output(force_progress=False):
-        out(t, u, v, state, held, force_progress, dt=step, steps=steps,
-            active=int(held.sum()))
 
-    step = dt
-    F_est = None  # the deformation at the last estimate
+class _CentralDifference:
+    """One central-difference run (:func:`central_difference`): its state
+    (``t``, ``u``, ``v``, ``a``, the forces, the dofs the walls hold), the
+    step controller, and the phases of a step, each a method — the step
+    size (:meth:`step_size`), the walls before and after the force
+    (:func:`_onto_walls`, :func:`_hold_on_walls`), the force with the
+    model's rebuild (:meth:`force`), the energy account and its check
+    (:meth:`account`), output and checkpoints (:meth:`report`,
+    :meth:`save`); ``times`` holds the seconds of each
+    (:class:`~skfem_pg.solvers.dynamics.Timings`)."""
 
-    def estimate():
+    def __init__(self, run, controls, exchange, t_end, dt, callback):
+        self.run, self.c, self.ex = run, controls, exchange
+        self.model, self.t_end, self.dt = run.model, t_end, dt
+        self.inv_m = np.where(run.free, 1.0 / run.m, 0.0)
+        self.times = Timings(("force", "commit", "estimate", "contact",
+                              "output"))
+        self.callback = callback
+        self.t, self.steps, self.step = 0.0, 0, dt
+        self.F_est = None  # the deformation at the last estimate
+        self.output_every = controls.output_every
+
+    # -- the start ------------------------------------------------------
+    def start(self, u, v, resume):
+        """The state at ``t = 0`` (or of the checkpoint ``resume``), the
+        energy account, the first step size and the first output."""
+        run, ex, times = self.run, self.ex, self.times
+        self.t_start = time.perf_counter()
+        with times("force"):
+            self.state = _evaluate(self.model, u, 0.0, None, v, exchange=ex)
+            self.fi = ex.complete(self.model.internal_force(self.state))
+        self.fe = run.f_of(0.0)
+        self.u, self.v = u, v
+        self.a = self.inv_m * (self.fe - self.fi)
+        self.held = np.zeros(len(u), dtype=bool)  # dofs a wall holds
+        self.energy = EnergyBalance(run.m, v, run.free, ex.sum(
+            stored_energy(self.model, self.state)), dot=ex.dot)
+        self.energy.D_c += _collective(
+            ex, hold_initial, run.walls, run.candidates, u, v, self.a, run.m,
+            self.held, ex.dot)
+        progress = Progress(self.t_end, self.c.verbose if ex.root else False)
+        self.out = Recorder(self.model, self.energy, run.free, progress,
+                            self.callback, self.times, total=ex.sum)
+        self.hist = self.out.hist
+        self.first_step(resume)
+        if resume is None:
+            self.output()
+            return
+        self.u, self.t, self.v, self.a, self.fi, self.held, saved = \
+            resume_run(resume, self.model, self.energy, self.hist,
+                       "explicit", controller=("steps", "step", "base",
+                                               "output_every"))
+        self.steps, self.step, self.base = int(saved["steps"]), float(
+            saved["step"]), float(saved["base"])
+        self.output_every = int(saved["output_every"])
+        self.F_est = saved.get("F_est")
+        self.state = _evaluate(self.model, self.u, self.t, self.hist,
+                               self.v, exchange=ex)
+        self.fe = run.f_of(self.t)
+
+    def estimate(self, safety):
         # always from the same start vector: a warm start from the last
         # Ritz vector converged to a lower Ritz value after a crack-aware
         # rebuild (energy balance error 2.4e-3 against 7.7e-4 cold)
-        return stable_time_step(model, m, u, free, safety, exchange=ex)
+        return stable_time_step(self.model, self.run.m, self.u,
+                                self.run.free, safety, exchange=self.ex)
 
-    if step is None:
-        t1 = time.perf_counter()
-        step = estimate()
-        F_est = _gradients(state)
-        times["estimate"] += time.perf_counter() - t1
-    elif resume is None:
-        # a fixed step above 2/omega_max grows without bound and died
-        # later as an "inverted point" (issue 47); the Ritz value is a
-        # lower bound of omega_max, so no stable step is refused
-        t1 = time.perf_counter()
-        limit = stable_time_step(model, m, u, free, 1.0, exchange=ex)
-        times["estimate"] += time.perf_counter() - t1
-        if step > limit:
-            raise ValueError(
-                "dt = {:.4g} is above the stable step 2/omega_max = {:.4g} "
-                "of central differences at the start: the run would "
-                "diverge.  Give dt <= {:.4g} or leave dt=None (the "
-                "estimated step times safety = {})".format(
-                    step, limit, limit, safety))
-    base = step  # the estimate's step, before the configuration scaling
-    if output_every is None:
-        output_every = max(1, int(round(t_end / step / 20)))
-    if resume is None:
-        output()
-    else:
-        u, t, v, a, fi, held, saved = resume_run(
-            resume, model, energy, hist, "explicit",
-            controller=("steps", "step", "base", "output_every"))
-        steps, step, base = int(saved["steps"]), float(saved["step"]), \
-            float(saved["base"])
-        output_every = int(saved["output_every"])
-        F_est = saved.get("F_est")
-        state = _evaluate(model, u, t, hist, v, exchange=ex)
-        fe = f_of(t)
-    every = Every.of(checkpoint)
-    while t < t_end * (1 - 1e-12):
-        if dt is None and steps:
-            t1 = time.perf_counter()
-            ratio = ex.max(compression_since(F_est, _gradients(state)))
-            if steps % estimate_every == 0 or ratio > REESTIMATE:
-                base = estimate()
-                F_est, ratio = _gradients(state), 1.0
-            step = base / ratio
-            times["estimate"] += time.perf_counter() - t1
+    def first_step(self, resume):
+        """The estimated step (``dt=None``), or ``dt`` checked against the
+        stable step."""
+        safety = self.c.safety
+        if self.step is None:
+            with self.times("estimate"):
+                self.step = self.estimate(safety)
+                self.F_est = _gradients(self.state)
+        elif resume is None:
+            # a fixed step above 2/omega_max grows without bound and died
+            # later as an "inverted point" (issue 47); the Ritz value is a
+            # lower bound of omega_max, so no stable step is refused
+            with self.times("estimate"):
+                limit = self.estimate(1.0)
+            if self.step > limit:
+                raise ValueError(
+                    "dt = {:.4g} is above the stable step 2/omega_max = "
+                    "{:.4g} of central differences at the start: the run "
+                    "would diverge.  Give dt <= {:.4g} or leave dt=None "
+                    "(the estimated step times safety = {})".format(
+                        self.step, limit, limit, safety))
+        self.base = self.step  # the estimate's, before the scaling
+        if self.output_every is None:
+            self.output_every = max(1, int(round(
+                self.t_end / self.step / 20)))
+
+    # -- a step ---------------------------------------------------------
+    def step_size(self):
+        """The step: the estimate scaled down by the compression since it
+        was made, estimated again every ``estimate_every`` steps or when
+        that scaling passes :data:`REESTIMATE` (``dt=None``)."""
+        if self.dt is None and self.steps:
+            with self.times("estimate"):
+                ratio = self.ex.max(compression_since(
+                    self.F_est, _gradients(self.state)))
+                if self.steps % self.c.estimate_every == 0 \
+                        or ratio > REESTIMATE:
+                    self.base = self.estimate(self.c.safety)
+                    self.F_est, ratio = _gradients(self.state), 1.0
+                self.step = self.base / ratio
+        step, t = self.step, self.t
         if not (np.isfinite(step) and step > 0) \
-                or steps + (t_end - t) / step > MAX_STEPS:
+                or self.steps + (self.t_end - t) / step > MAX_STEPS:
             raise DynamicsError(
                 "central differences: the stable step collapsed to {:.3g} "
                 "at t = {:.6g} (step {}): {:.3g} more steps to t_end"
-                .format(step, t, steps, (t_end - t) / step if step else
-                        np.inf), t=t, x=u, v=v, history=hist)
-        h = min(step, t_end - t)
+                .format(step, t, self.steps, (self.t_end - t) / step if step
+                        else np.inf), t=t, x=self.u, v=self.v,
+                history=self.hist)
+        return min(step, self.t_end - t)
+
+    def force(self, un, t):
+        """The state and the internal force at ``un``; after a rebuild
+        of the model's basis (a commit that returns ``True``) those of the
+        new basis."""
+        ex, model = self.ex, self.model
+        with self.times("force"):
+            state = _evaluate(model, un, t, self.hist, self.v, self.u,
+                              exchange=ex)
+            fi_n = ex.complete(model.internal_force(state))
+        with self.times("commit"):
+            if _collective(ex, commit, model, state, t, self.u, self.v,
+                           self.hist):
+                state = _evaluate(model, un, t, self.hist, self.v, self.u,
+                                  exchange=ex)
+                fi_n = ex.complete(model.internal_force(state))
+        return state, fi_n
+
+    def advance(self):
+        """One step from ``t`` to ``t + h``."""
+        run, Dd = self.run, self.run.D
+        u, v, a, h = self.u, self.v, self.a, self.step_size()
         vh = v + 0.5 * h * a
         un = u + h * vh
-        un[Dd] = uD_of(t + h)[Dd]
+        un[Dd] = run.uD_of(self.t + h)[Dd]
         vh[Dd] = (un[Dd] - u[Dd]) / h
-        t1 = time.perf_counter()
-        was_held = held.copy()
-        _onto_walls(walls, cand, held, u, un, vh, h)
-        times["contact"] += time.perf_counter() - t1
-        t1 = time.perf_counter()
-        state = _evaluate(model, un, t + h, hist, v, u, exchange=ex)
-        fi_n = ex.complete(model.internal_force(state))
-        t2 = time.perf_counter()
-        if _collective(ex, commit, model, state, t + h, u, v, hist):
-            # the families were rebuilt: the force of the new basis
-            state = _evaluate(model, un, t + h, hist, v, u, exchange=ex)
-            fi_n = ex.complete(model.internal_force(state))
-        times["commit"] += time.perf_counter() - t2
-        times["force"] += t2 - t1
-        fe_n = f_of(t + h)
-        a_n = inv_m * (fe_n - fi_n)
+        with self.times("contact"):
+            was_held = self.held.copy()
+            _onto_walls(run.walls, run.candidates, self.held, u, un, vh, h)
+        self.state, fi_n = self.force(un, self.t + h)
+        fe_n = run.f_of(self.t + h)
+        a_n = self.inv_m * (fe_n - fi_n)
         vn = vh + 0.5 * h * a_n
         vn[Dd] = vh[Dd]
-        t1 = time.perf_counter()
-        _hold_on_walls(walls, cand, held, un, vn, a_n, h)
-        touched = np.flatnonzero(held | was_held)
-        times["contact"] += time.perf_counter() - t1
-        energy.step(un - u, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
-                    free & ~was_held, free & ~held)
-        u, v, a, fi, fe = un, vn, a_n, fi_n, fe_n
-        t += h
-        steps += 1
-        rec_err = energy.record(t, v, free & ~held)
-        if abs(rec_err["relative_error"]) > max_energy_error and \
-                steps > STARTUP_STEPS:
+        with self.times("contact"):
+            _hold_on_walls(run.walls, run.candidates, self.held, un, vn,
+                           a_n, h)
+            touched = np.flatnonzero(self.held | was_held)
+        self.energy.step(un - u, self.fi, fi_n, self.fe, fe_n, Dd, touched,
+                         v, vn, run.free & ~was_held, run.free & ~self.held)
+        self.u, self.v, self.a, self.fi, self.fe = un, vn, a_n, fi_n, fe_n
+        self.t += h
+        self.steps += 1
+        self.report(h, self.account(h))
+
+    def account(self, h):
+        """The step's energy record; an error above
+        ``max_energy_error`` after :data:`STARTUP_STEPS` stops the run."""
+        rec = self.energy.record(self.t, self.v, self.run.free & ~self.held)
+        if abs(rec["relative_error"]) > self.c.max_energy_error and \
+                self.steps > STARTUP_STEPS:
             raise DynamicsError(
                 "central differences: energy balance error {:.3g} > "
                 "{:.3g} at t = {:.6g} (step {}, dt {:.3g}): the step is "
                 "unstable (increase safety margin: safety < {})".format(
-                    rec_err["relative_error"], max_energy_error, t, steps,
-                    h, safety), t=t, x=u, v=v, history=hist)
-        if steps % output_every == 0 or t >= t_end * (1 - 1e-12):
-            output(force_progress=t >= t_end * (1 - 1e-12))
+                    rec["relative_error"], self.c.max_energy_error, self.t,
+                    self.steps, h, self.c.safety), t=self.t, x=self.u,
+                v=self.v, history=self.hist)
+        return rec
+
+    # -- output ---------------------------------------------------------
+    def output(self, force_progress=False):
+        self.out(self.t, self.u, self.v, self.state, self.held,
+                 force_progress, dt=self.step, steps=self.steps,
+                 active=int(self.held.sum()))
+
+    def report(self, h, rec):
+        """An output every ``output_every`` steps and at the end, else a
+        progress line."""
+        final = self.t >= self.t_end * (1 - 1e-12)
+        if self.steps % self.output_every == 0 or final:
+            self.output(force_progress=final)
         else:
-            progress(t, h, steps, rec_err)
-        if every is not None:
-            save_run(every, steps, model, u, t, v, a, fi, held, energy, hist,
-                     "explicit", steps=steps, step=step, base=base,
-                     output_every=output_every,
-                     **({} if F_est is None else {"F_est": F_est}))
-    times["total"] = time.perf_counter() - t_start
-    return Trajectory(u, v, a, t, hist, steps, times)
+            self.out.progress(self.t, h, self.steps, rec)
+
+    def save(self, every):
+        """A checkpoint, if ``every`` says it is due."""
+        save_run(every, self.steps, self.model, self.u, self.t, self.v,
+                 self.a, self.fi, self.held, self.energy, self.hist,
+                 "explicit", steps=self.steps, step=self.step,
+                 base=self.base, output_every=self.output_every,
+                 **({} if self.F_est is None else {"F_est": self.F_est}))
+
+    def trajectory(self):
+        self.times["total"] = time.perf_counter() - self.t_start
+        return Trajectory(self.u, self.v, self.a, self.t, self.hist,
+                          self.steps, dict(self.times))
 
 
 def _onto_walls(walls, cand, held, u, un, vh, h):

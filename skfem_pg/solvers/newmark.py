@@ -34,14 +34,15 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model, require_model
-from ..dofs import as_dofs, check_sliding
+from ..formulations.protocol import Model
+from ..dofs import check_sliding
 from .contact import hold_initial
 from .checkpoint import Every
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
-                       Trajectory, bind_walls, check_run, commit, free_mask,
-                       resume_run, save_run, stored_energy, time_functions)
+                       Trajectory, bind_problem, check_run, commit,
+                       resume_run, save_run, stored_energy)
 from .controls import NewmarkControls
+from .problem import Problem
 from .static import condensed_solver, newton_step
 
 
@@ -112,7 +113,8 @@ def check_conditional_stability(model, m, x, free, dt, beta, gamma,
                              limit))
 
 
-def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
+def newmark(model: Model | Problem, m: ArrayLike | None = None,
+            t_end: float | None = None, dt: float | None = None,
             f_ext: ArrayLike | Callable | None = None, D=None,
             u_D: ArrayLike | Callable | None = None,
             u0: ArrayLike | None = None, v0: ArrayLike | None = None,
@@ -126,9 +128,14 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
     Parameters
     ----------
     model
-        Any model of :mod:`skfem_pg.formulations` (FE or PG, mixed too).
+        A :class:`~skfem_pg.solvers.problem.Problem` (its model, loads,
+        Dirichlet data, walls and mass; then give ``t_end`` and ``dt``
+        by keyword), or any model of :mod:`skfem_pg.formulations` (FE or
+        PG, mixed too) with the keywords below.
     m
         Diagonal mass per displacement dof (:func:`lumped_mass`).
+    t_end
+        The end time.
     dt
         Initial (and largest) step.
     f_ext, D, u_D
@@ -166,19 +173,22 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
         data (``dt``, Newton ``iterations``, ``cuts``) per output, the
         seconds of assembly, linear solves and output.
     """
-    model = require_model(model, "newmark")
+    problem = Problem.of(model, "newmark", f_ext=f_ext, D=D, u_D=u_D,
+                         wall=wall, m=m)
+    model = problem.model
     basis, N, n_u = model.basis, model.N, model.n_u
     c = NewmarkControls.of(controls, **kw)
     beta, gamma, dt_min, verbose = c.beta, c.gamma, c.dt_min, c.verbose
-    m = check_run(n_u, N, m, t_end, dt, u0, v0, dt_required=True)
+    m = check_run(n_u, N, problem.require_mass("newmark"), t_end, dt, u0,
+                  v0, dt_required=True)
     if dt_min is not None and not (np.isfinite(dt_min)
                                    and 0 < dt_min <= dt):
         raise ValueError("dt_min must lie in (0, dt], got {!r}".format(
             dt_min))
-    Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
+    run = bind_problem(problem, m)
+    Dd, free, f_of, uD_of = run.D, run.free, run.f_of, run.uD_of
+    walls, cand = run.walls, run.candidates
     check_sliding(basis, Dd)
-    f_of, uD_of = time_functions(model, f_ext, u_D)
-    walls, cand = bind_walls(wall, basis, n_u, Dd)
     dt_min = dt / 1024 if dt_min is None else dt_min
     x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
     x = x0.copy()
@@ -187,7 +197,6 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
         x[:u0.shape[0]] = u0
     x[Dd] = uD_of(0.0)[Dd]
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
-    free = free_mask(n_u, Dd)
     held = np.zeros(n_u, dtype=bool)
     times = dict.fromkeys(("assemble", "linear", "output", "contact"), 0.0)
     if resume is None:
@@ -224,9 +233,8 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
         output()
     while t < t_end * (1 - 1e-12):
         h = min(step, t_end - t)
-        ok, res = _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of,
-                        walls, cand, beta, gamma, c.tol, c.maxiter, solver,
-                        solvers, times, c.max_contact_passes, c.line_search)
+        ok, res = _step(run, c, (x, v, a, held), t, h, solver, solvers,
+                        times)
         if not ok:
             cuts += 1
             step = h / 2
@@ -266,12 +274,18 @@ def newmark(model: Model, m: ArrayLike, t_end: float, dt: float,
     return Trajectory(x, v, a, t, hist, steps, times)
 
 
-def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
-          cand, beta, gamma, tol, maxiter, solver, solvers, times,
-          max_passes, line_search=False):
-    """One Newmark step from ``t`` to ``t + h``, repeated while the wall's
-    active set changes: ``(True, (x, v, a, f_int, state, held, info))``
-    or ``(False, reason)``."""
+def _step(run, controls, start_state, t, h, solver, solvers, times):
+    """One Newmark step of the :class:`~skfem_pg.solvers.dynamics.
+    BoundProblem` ``run`` with the ``controls`` from ``t`` to ``t + h``
+    and the state ``(x, v, a, held)``, repeated while the wall's active
+    set changes: ``(True, (x, v, a, f_int, state, held, info))`` or
+    ``(False, reason)``."""
+    model, m, free, Dd = run.model, run.m, run.free, run.D
+    f_of, uD_of, walls, cand = run.f_of, run.uD_of, run.walls, \
+        run.candidates
+    x, v, a, held = start_state
+    beta, gamma = controls.beta, controls.gamma
+    max_passes = controls.max_contact_passes
     n_u = m.shape[0]
     N = x.shape[0]
     c = 1.0 / (beta * h * h)
@@ -297,7 +311,8 @@ def _step(model, x, v, a, h, t, m, free, held, Dd, f_of, uD_of, walls,
         inert = _Inertial(model, mm, c, u_tilde)
         ok, xn, info, state = newton_step(inert, start, 1.0, f_of(t + h),
                                            C, values[C], I, solvers[key],
-                                           tol, maxiter, line_search)
+                                           controls.tol, controls.maxiter,
+                                           controls.line_search)
         times["assemble"] += info["t_assemble"]
         times["linear"] += info["t_linear"]
         if not ok:

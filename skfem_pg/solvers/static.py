@@ -21,7 +21,8 @@ from typing import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..formulations.protocol import Model, require_model
+from ..formulations.protocol import Model
+from .problem import Problem, Solution
 from ..dofs import as_dofs, check_sliding
 from ..materials import ReturnMapError
 from .checkpoint import Every, load as load_checkpoint
@@ -75,18 +76,19 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
            load0: float = 0.0, callback: Callable | None = None,
            checkpoint=None, resume: str | None = None,
            controls: NewtonControls | None = None,
-           **kw) -> tuple[np.ndarray, list]:
+           **kw) -> Solution:
     r"""Solve :math:`f_{int}(x) = \lambda f_{ext}` up to :math:`\lambda = 1`
     with adaptive load steps.
 
     Parameters
     ----------
     model
-        A :mod:`skfem_pg.formulations` model, e.g.
-        ``Hyperelastic(basis, NeoHooke(lam, mu))``.  Its unknowns ``x``
-        are the displacements (``model.n_u``, scikit-fem numbering of
-        ``model.basis``) followed by its global extra fields, if any
-        (``model.N`` in all).
+        A :class:`~skfem_pg.solvers.problem.Problem` (the model with its
+        ``f_ext``, ``D``, ``u_D``), or a :mod:`skfem_pg.formulations`
+        model, e.g. ``Hyperelastic(basis, NeoHooke(lam, mu))``, with the
+        keywords below.  Its unknowns ``x`` are the displacements
+        (``model.n_u``, scikit-fem numbering of ``model.basis``) followed
+        by its global extra fields, if any (``model.N`` in all).
     f_ext
         External force vector at load factor 1 (default 0): one entry per
         displacement dof (or per unknown).
@@ -130,7 +132,8 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
 
     Returns
     -------
-    x, history
+    Solution
+        ``(x, history)``, a named record that unpacks as a pair.
         ``x``: all unknowns (``model.N``; the displacements are
         ``x[:model.n_u]``).  ``history`` is a list of dicts per converged
         step (load factor, residual norms per iteration, the increments'
@@ -162,7 +165,9 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     """
     opts = NewtonControls.of(controls, **kw)
     check_controls(load0=load0)
-    model = require_model(model, "newton")
+    problem = Problem.of(model, "newton", f_ext=f_ext, D=D, u_D=u_D)
+    model, f_ext, D, u_D = problem.model, problem.f_ext, problem.D, \
+        problem.u_D
     basis, N, n_u = model.basis, model.N, model.n_u
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
@@ -214,9 +219,9 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
         return out
 
     try:
-        return load_stepping(model, step, SERIAL, u, lam, dlam, opts,
-                             prev=prev, callback=callback,
-                             every=Every.of(checkpoint))
+        return Solution(*load_stepping(
+            model, step, SERIAL, u, lam, dlam, opts, prev=prev,
+            callback=callback, every=Every.of(checkpoint)))
     finally:
         if kept is not None:
             kept.free()
