@@ -119,7 +119,7 @@ def test_unpadded_pipeline_equals_padded(boundary, families):
     """The default PBG pipeline (MTE1, bond, V5) runs per size group; the
     same kernels on the padded arrays give the same derivatives."""
     from skfem_pg.discretization.corrections import (
-        bond_correction, correction_functions, vc_correction)
+        VCSystem, bond_correction, correction_functions, vc_correction)
     from skfem_pg.discretization.quadrature import weight_rule
     from skfem_pg.discretization.shape import GRADIENTS
     p = pg.Particles.from_mesh(cube(3, 0.3, kind="tet"))
@@ -128,10 +128,10 @@ def test_unpadded_pipeline_equals_padded(boundary, families):
     fam, x, V, n = b.families, p.x, p.volumes, b.weight_exponent
     G = bond_correction(GRADIENTS["MTE1"](x, V, fam, n=n), x, fam)
     dx = weight_rule(b.weights)(V, fam)
-    Gc, rep = vc_correction(G, dx, x, V, fam, p.area_vectors(),
-                            correction_functions("V5", x, V, fam, n=n),
-                            boundary=boundary,
-                            surface=p.surface_area_vectors())
+    Gc, rep = vc_correction(
+        VCSystem(G, dx, x, V, fam, p.area_vectors(),
+                 correction_functions("V5", x, V, fam, n=n),
+                 p.surface_area_vectors()), boundary=boundary)
     assert rel(b.dx, dx) < 1e-15
     assert rel(b.G, Gc) < 1e-12
     assert abs(rep.residual_after - b.vc_report.residual_after) < 1e-12

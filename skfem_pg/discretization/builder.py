@@ -48,7 +48,7 @@ from . import families as families_mod
 from . import petrov
 from . import recipes
 from ..errors import FamilyError, describe_particle
-from .corrections import (bond_correction, check_correction,
+from .corrections import (VCSystem, bond_correction, check_correction,
                           correction_functions, vc_correction)
 from .families import Families
 from .quadrature import weight_rule
@@ -250,24 +250,9 @@ class BasisSpec:
                     "weights={!r}: family_quadrature='moments' makes its "
                     "own weights (the hat functions' moments)".format(
                         weights))
-            if families is None:  # the 1-ring, a quadratic fit's members
-                if particles.mesh is None:
-                    raise ValueError(
-                        "family_quadrature='moments' needs particles "
-                        "collocated from a mesh's vertices (their hat "
-                        "functions' moments and 1-ring families)")
-                families = parts_mod.FamilyRule("mesh", tuple(sorted(
-                    moment_family_options(particles.dim).items())))
             weights = "uniform"  # not used: the rule makes its own
-        if families is None and shape == "WTE2":
-            # twice the d + d(d+1)/2 quadratic moments, plus the master:
-            # with fewer, corner families of graded meshes (Cook's (48,
-            # 60) at 7 members) give a singular WTE2 moment matrix
-            d = particles.dim
-            families = parts_mod.FamilyRule("horizon", (
-                ("factor", 2.51), ("min_size", 1 + 2 * (d + d * (d + 1) // 2))))
-        elif families is None and particles.mesh is None:
-            families = "horizon"
+        if families is None:
+            families = _default_rule(particles, shape, family_quadrature)
         rule = families.rule if isinstance(families, parts_mod.FamilyRule) \
             and not families.parameters else families
         rule, weights, weight_exponent, _ = recipes.resolve(
@@ -285,6 +270,28 @@ class BasisSpec:
                 bool(bond), vc, vc_boundary, vc_solver, vc_exclude,
                 vc_tolerance),
             method=method), dim)
+
+
+def _default_rule(particles, shape, family_quadrature):
+    """The family rule of a basis without ``families``: the moment
+    quadrature's 1-ring, WTE2's horizon, a horizon without a mesh, else
+    ``None`` (the recipe's, :mod:`~skfem_pg.discretization.recipes`)."""
+    d = particles.dim
+    if family_quadrature == "moments":  # the 1-ring, a quadratic fit's
+        if particles.mesh is None:
+            raise ValueError(
+                "family_quadrature='moments' needs particles collocated "
+                "from a mesh's vertices (their hat functions' moments and "
+                "1-ring families)")
+        return parts_mod.FamilyRule("mesh", tuple(sorted(
+            moment_family_options(d).items())))
+    if shape == "WTE2":
+        # twice the d + d(d+1)/2 quadratic moments, plus the master: with
+        # fewer, corner families of graded meshes (Cook's (48, 60) at 7
+        # members) give a singular WTE2 moment matrix
+        return parts_mod.FamilyRule("horizon", (
+            ("factor", 2.51), ("min_size", 1 + 2 * (d + d * (d + 1) // 2))))
+    return "horizon" if particles.mesh is None else None
 
 
 def _keyword(part, field):
@@ -344,22 +351,30 @@ class _Context:
         return correction_functions(variant, p.x, p.volumes, self.families,
                                     n=self.spec.weight_exponent)
 
+    def system(self, G, dx, variant):
+        """The :class:`~skfem_pg.discretization.corrections.VCSystem` of
+        derivatives ``G`` with weights ``dx`` and the correction functions
+        of ``variant``."""
+        p = self.particles
+        return VCSystem(G, dx, p.x, p.volumes, self.families, self.area,
+                        self.phi(variant), self.surface)
+
+    def options(self):
+        """The keywords of a first-order VC solve, from the spec."""
+        s = self.spec
+        return dict(variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
+                    boundary=s.vc_boundary)
+
 
 def _first_order_pbg(c):
-    s, p = c.spec, c.particles
-    c.G, c.report = c.vc_solve(
-        c.G, c.dx, p.x, p.volumes, c.families, c.area, c.phi(s.vc),
-        variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
-        boundary=s.vc_boundary, surface=c.surface)
+    c.G, c.report = c.vc_solve(c.system(c.G, c.dx, c.spec.vc),
+                               **c.options())
 
 
 def _first_order_ppg1(c):
     # (5.16) is (5.18) with the master weights only
-    s, p = c.spec, c.particles
-    c.Gt, c.report = c.vc_solve(
-        c.Gt, c.dx_t, p.x, p.volumes, c.families, c.area, c.phi(s.vc),
-        variant=s.vc, solver=s.vc_solver, exclude=s.vc_exclude,
-        boundary=s.vc_boundary, surface=c.surface)
+    c.Gt, c.report = c.vc_solve(c.system(c.Gt, c.dx_t, c.spec.vc),
+                                **c.options())
 
 
 def _first_order_ppg2(c):  # (5.17), its own sparse system
@@ -379,9 +394,8 @@ def _second_order_pbg(c):
     # V4-type functions keep the trial's quadratic consistency
     s, p = c.spec, c.particles
     c.G, c.report = vc2_correction(
-        c.G, c.dx, p.x, p.volumes, c.families, c.area, p.area_moments(),
-        c.phi(s.vc), exclude=s.vc_exclude, boundary=s.vc_boundary,
-        surface=c.surface)
+        c.system(c.G, c.dx, s.vc), p.area_moments(), exclude=s.vc_exclude,
+        boundary=s.vc_boundary)
 
 
 def _second_order_ppg1(c):
@@ -394,9 +408,8 @@ def _second_order_ppg1(c):
         "on a manufactured solution; prefer PBG's VC2")
     s, p = c.spec, c.particles
     c.Gt, c.report = vc2_correction(
-        c.Gt, c.dx_t, p.x, p.volumes, c.families, c.area, p.area_moments(),
-        c.phi("V1"), exclude=s.vc_exclude, boundary=s.vc_boundary,
-        method="PPG1", surface=c.surface)
+        c.system(c.Gt, c.dx_t, "V1"), p.area_moments(),
+        exclude=s.vc_exclude, boundary=s.vc_boundary, method="PPG1")
 
 
 #: VC corrections of the padded pipeline, ``(method, order)`` ->
@@ -557,10 +570,10 @@ def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
         phis = [correction_functions(spec.vc, x, V, f,
                                      n=spec.weight_exponent) for f in subs]
         Gs, report = vc_solve(
-            Gs, dxs, x, V, subs, area, phis, variant=spec.vc,
-            solver=spec.vc_solver, boundary=spec.vc_boundary,
-            surface=surface_of(particles),
-            index=[g.families for g in L])
+            VCSystem(Gs, dxs, x, V, subs, area, phis, surface_of(particles),
+                     [g.families for g in L]),
+            variant=spec.vc, solver=spec.vc_solver,
+            boundary=spec.vc_boundary)
         timings["vc"] = time.perf_counter() - t0
     check_correction(Gs, x, subs, report, spec.vc_tolerance,
                      what=_what(spec))

@@ -33,6 +33,7 @@ VC correction (5.56)–(5.68)
 import time
 import warnings
 from dataclasses import dataclass, field
+from typing import Any, NamedTuple, Optional
 
 import numpy as np
 import scipy.sparse as sp
@@ -424,32 +425,69 @@ def vc_apply(parts, Qs, alpha):
     return Gc
 
 
-def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
-                  solver="auto", tol=1e-14, maxiter=None, exclude=None,
-                  boundary="min-norm", surface=None, index=None):
-    r"""Correct ``G`` so the PBG integration constraint holds.
+class VCSystem(NamedTuple):
+    r"""The arrays a VC correction reads (:func:`vc_correction`,
+    :func:`~skfem_pg.discretization.vc2.vc2_correction`,
+    :func:`~skfem_pg.discretization.local_vc.local_vc_correction`, the
+    distributed solve): what the integration constraint (5.18) is made
+    of.
 
-    Parameters
+    Attributes
     ----------
     G
         ``(nf, m, m, d)`` derivatives (bond corrected for V5).  Unpadded:
-        ``G``, ``dx``, ``fam`` and ``phi`` may instead be lists with one
-        entry per size group (:mod:`skfem_pg.discretization.layout`; ``fam``
-        the groups'
-        :meth:`~skfem_pg.discretization.layout.SizeGroups.subset` families) and
-        ``index`` the groups' family indices; the corrected ``G`` is then a
-        list too.
+        ``G``, ``dx``, ``families`` and ``phi`` may instead be lists with
+        one entry per size group (:mod:`skfem_pg.discretization.layout`;
+        ``families`` the groups'
+        :meth:`~skfem_pg.discretization.layout.SizeGroups.subset`
+        families) and ``index`` the groups' family indices; the corrected
+        ``G`` is then a list too.
     dx
         ``(nf, m)`` PBG weights :math:`w_{kj}`.
     x, volumes
         Particle positions ``(d, np)`` and volumes.
-    fam
+    families
         :class:`~skfem_pg.discretization.families.Families`.
     area
         ``(d, np)`` area vectors :math:`A^i`.
     phi
         ``(nf, m)`` correction function values
         (:func:`correction_functions`).
+    surface
+        ``(d, np)`` area vectors over the true surface only (default
+        ``area``): with ``s``/``sn`` the particles where it is non-zero
+        are the surface particles, and its direction their normal.  For a
+        PG subdomain coupled to FE the interface particles have a non-zero
+        ``area`` but keep their constraints
+        (:meth:`~skfem_pg.Particles.surface_area_vectors`); under ``sn``
+        the surface particles on the interface's edge are fixed fully, as
+        under ``s``
+        (:func:`~skfem_pg.discretization.vc_boundary.interface_edge`).
+    index
+        With list arguments: per group its family indices.
+    """
+
+    G: Any
+    dx: Any
+    x: np.ndarray
+    volumes: np.ndarray
+    families: Any
+    area: np.ndarray
+    phi: Any
+    surface: Optional[np.ndarray] = None
+    index: Any = None
+
+
+def vc_correction(system, variant="V5", solver="auto", tol=1e-14,
+                  maxiter=None, exclude=None, boundary="min-norm"):
+    r"""Correct the derivatives of ``system`` so the PBG integration
+    constraint holds.
+
+    Parameters
+    ----------
+    system
+        :class:`VCSystem`: the derivatives, weights, particles, families,
+        area vectors and correction functions.
     variant
         ``"V5"`` (with bond projector, keeps the bond mapping), ``"V3"``,
         ``"V4"``, ``"V1"`` (no projector) or ``"V2"`` (matrix-valued
@@ -481,25 +519,13 @@ def vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
         With ``s``/``sn`` the surface particles' discrete area vectors
         differ from :math:`A^i` by ``VCReport.area_correction``, which
         consistent Neumann loads must include.
-    surface
-        ``(d, np)`` area vectors over the true surface only (default
-        ``area``): with ``s``/``sn`` the particles where it is non-zero
-        are the surface particles, and its direction their normal.  For a
-        PG subdomain coupled to FE the interface particles have a non-zero
-        ``area`` but keep their constraints
-        (:meth:`~skfem_pg.Particles.surface_area_vectors`); under ``sn``
-        the surface particles on the interface's edge are fixed fully, as
-        under ``s``
-        (:func:`~skfem_pg.discretization.vc_boundary.interface_edge`).
-
-    index
-        With list arguments: per group its family indices.
 
     Returns
     -------
     G_corrected, VCReport
 
     """
+    G, dx, x, volumes, fam, area, phi, surface, index = system
     _check_vc_options(variant, boundary, exclude)
     grouped = isinstance(G, (list, tuple))
     parts, masters, B, Qs = vc_parts(G, dx, fam, phi, index, x, variant)

@@ -131,15 +131,16 @@ def family_shares(S, masters, mem, mask, x):
     return out
 
 
-def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
-                        boundary="min-norm", index=None, shares=None,
-                        complete=None, together=None, **ignored):
+def local_vc_correction(system, variant="V5", boundary="min-norm",
+                        shares=None, complete=None, together=None,
+                        **ignored):
     r"""Correct ``G`` family by family so each family meets its share of
     the integration constraint (module docstring).
 
     The arguments are those of
-    :func:`~skfem_pg.discretization.corrections.vc_correction` (``phi``
-    is not used: the local correction has one vector per family and shape
+    :func:`~skfem_pg.discretization.corrections.vc_correction` (of the
+    :class:`~skfem_pg.discretization.corrections.VCSystem`, ``phi`` is
+    not used: the local correction has one vector per family and shape
     function); ``shares`` is ``f(masters, mem, mask) -> (nf, m, d)`` (the
     caller's :func:`family_shares` on its mesh, in the numbering of
     ``x``).  Returns ``(G_corrected, VCReport)``; the report's residuals
@@ -151,6 +152,7 @@ def local_vc_correction(G, dx, x, volumes, fam, area, phi, variant="V5",
     :func:`~skfem_pg.distributed.comm.raise_together`) raises an error of
     one part's families on every part before the residual is summed.
     """
+    G, dx, x, volumes, fam, area, phi, _, index = system
     if variant not in ("V3", "V5"):
         raise ValueError("local VC corrects with V3 or V5 (the bond "
                          "projector), got vc={!r}".format(variant))

@@ -153,6 +153,11 @@ class FamilyRule(Part):
         return rule(particles, **dict(self.parameters))
 
     def refusal(self, capability, parts):
+        if capability == "mpi" and not self.given and \
+                self.rule not in ("mesh", "nearest"):
+            return ("families={} on MPI: a rank builds its families from "
+                    "the mesh (rule 'mesh'), its nearest particles (rule "
+                    "'nearest') or takes them given".format(self.describe()))
         if capability == "crack_rebuild" and (self.given or self.parameters
                                               or self.rule != "mesh"):
             return ("crack-aware families rebuild the families from the "
@@ -398,9 +403,9 @@ class Parts:
     correction: Correction = dataclasses.field(default_factory=Correction)
     method: Method = dataclasses.field(default_factory=Method)
 
-    def __iter__(self):
-        return iter((self.family_rule, self.shape, self.quadrature,
-                     self.correction, self.method))
+    def __iter__(self):  # the family rule last: its defaults follow
+        return iter((self.shape, self.quadrature, self.correction,
+                     self.method, self.family_rule))
 
 
 def conflict(parts):

@@ -154,18 +154,20 @@ def _blocks_to_csr(M, fam, d):
                          shape=((d + 1) * fam.n_particles, (d + 1) * nf))
 
 
-def vc2_correction(G, dx, x, volumes, fam, area, area2, phi, exclude=None,
-                   tol=1e-15, maxiter=None, boundary="min-norm",
-                   method="PBG", surface=None):
-    """Second-order VC correction of PBG derivatives ``G`` (quadratic
-    consistent, e.g. WTE2); ``area`` :math:`A^i` ``(d, n)``, ``area2``
-    :math:`A_2^i` ``(d, d, n)`` about the origin 0, ``phi`` the correction
-    function ``(nf, m)`` (V4; for PPG1 also V1/V3); ``boundary``
+def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
+                   boundary="min-norm", method="PBG"):
+    """Second-order VC correction of the PBG derivatives ``G`` of
+    ``system`` (a :class:`~skfem_pg.discretization.corrections.VCSystem`;
+    quadratic consistent, e.g. WTE2; padded, ``index`` unused); ``area``
+    :math:`A^i` ``(d, n)``, ``area2`` :math:`A_2^i` ``(d, d, n)`` about
+    the origin 0, ``phi`` the correction function ``(nf, m)`` (V4; for
+    PPG1 also V1/V3); ``boundary``
     ``"min-norm"`` (LSQR) or ``"s"`` (sparse LU).  ``method="PPG1"``
     corrects PPG1 test derivatives instead (``G`` nonzero at ``j = 0``
     only, ``dx`` the master weights): constraint (5.24), ansatz of
     :func:`_system_ppg1`.  Returns ``(G_corrected, VCReport)``.
     """
+    G, dx, x, volumes, fam, area, phi, surface, _ = system
     if method not in ("PBG", "PPG1"):
         raise ValueError("VC2 is implemented for PBG and PPG1, not {!r}"
                          .format(method))

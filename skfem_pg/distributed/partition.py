@@ -342,11 +342,6 @@ class Partition:
                 self.particles, method, options.get("shape", "MTE1"))]
         else:
             w, n = recipes.weights_of_rule(families)
-        if families not in ("mesh", "nearest"):
-            raise NotImplementedError(
-                "families={!r} on MPI: a rank builds its families from "
-                "the mesh (rule 'mesh'), its nearest particles (rule "
-                "'nearest') or takes them given".format(families))
         if method != "PBG":  # PPG integrates with the member volumes
             return families
         for key, value in (("weights", w), ("weight_exponent", n)):

@@ -163,15 +163,16 @@ def solve_pinned(part, rows, cols, vals, fid, B, b, anchors, min_norm=True):
     return (alpha.ravel() - Z @ coef).reshape(nf, d), its
 
 
-def vc_correction(part, G, dx, x, volumes, fam, area, phi, variant="V5",
-                  solver="auto", exclude=None, boundary="min-norm",
-                  surface=None, index=None):
+def vc_correction(part, system, variant="V5", solver="auto", exclude=None,
+                  boundary="min-norm"):
     """:func:`~skfem_pg.discretization.corrections.vc_correction` of the
     families of partition ``part`` with the global constraint system
-    (:mod:`~skfem_pg.distributed.partition`): the arguments are the local
-    ones, as the basis passes them.  ``solver`` ``"direct"``/``"amg"``
+    (:mod:`~skfem_pg.distributed.partition`): ``system`` (a
+    :class:`~skfem_pg.discretization.corrections.VCSystem`) holds the
+    local arrays, as the basis passes them.  ``solver`` ``"direct"``/``"amg"``
     (``"auto"``): rank 0 solves the gathered system with the serial code;
     ``"petsc"``: all ranks (:func:`solve_pinned`)."""
+    G, dx, x, volumes, fam, area, phi, surface, index = system
     t0 = time.perf_counter()
     grouped = isinstance(G, (list, tuple))
     parts, masters_l, B_l, Qs = vc_parts(G, dx, fam, phi, index, x,

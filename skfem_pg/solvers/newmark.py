@@ -39,7 +39,7 @@ from ..dofs import check_sliding
 from .contact import hold_initial
 from .checkpoint import Every
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
-                       Trajectory, bind_problem, check_run, commit,
+                       Timings, Trajectory, bind_problem, check_run, commit,
                        resume_run, save_run, stored_energy)
 from .controls import NewmarkControls
 from .problem import Problem
@@ -176,102 +176,148 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
     problem = Problem.of(model, "newmark", f_ext=f_ext, D=D, u_D=u_D,
                          wall=wall, m=m)
     model = problem.model
-    basis, N, n_u = model.basis, model.N, model.n_u
+    N, n_u = model.N, model.n_u
     c = NewmarkControls.of(controls, **kw)
-    beta, gamma, dt_min, verbose = c.beta, c.gamma, c.dt_min, c.verbose
     m = check_run(n_u, N, problem.require_mass("newmark"), t_end, dt, u0,
                   v0, dt_required=True)
-    if dt_min is not None and not (np.isfinite(dt_min)
-                                   and 0 < dt_min <= dt):
+    if c.dt_min is not None and not (np.isfinite(c.dt_min)
+                                     and 0 < c.dt_min <= dt):
         raise ValueError("dt_min must lie in (0, dt], got {!r}".format(
-            dt_min))
+            c.dt_min))
     run = bind_problem(problem, m)
-    Dd, free, f_of, uD_of = run.D, run.free, run.f_of, run.uD_of
-    walls, cand = run.walls, run.candidates
-    check_sliding(basis, Dd)
-    dt_min = dt / 1024 if dt_min is None else dt_min
-    x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
-    x = x0.copy()
+    check_sliding(model.basis, run.D)
+    x = (model.initial() if hasattr(model, "initial")
+         else np.zeros(N)).copy()
     if u0 is not None:  # displacements, or all unknowns (check_run)
         u0 = np.asarray(u0, dtype=float)
         x[:u0.shape[0]] = u0
-    x[Dd] = uD_of(0.0)[Dd]
+    x[run.D] = run.uD_of(0.0)[run.D]
     v = np.zeros(n_u) if v0 is None else np.asarray(v0, float).copy()
-    held = np.zeros(n_u, dtype=bool)
-    times = dict.fromkeys(("assemble", "linear", "output", "contact"), 0.0)
     if resume is None:
-        check_conditional_stability(model, m, x, free, dt, beta, gamma,
-                                    N == n_u)
-    state = model.state(x)
-    fi = np.asarray(model.internal_force(state), dtype=float)
-    fe = f_of(0.0)
-    a = np.where(free, (fe[:n_u] - fi[:n_u]) / m, 0.0)
-    energy = EnergyBalance(m, v, free, stored_energy(model, state))
-    energy.D_c += hold_initial(walls, cand, x, v, a, m, held)
-    progress = Progress(t_end, verbose)
-    out = Recorder(model, energy, free, progress, callback,
-                   times)
-    hist = out.hist
-    t, steps, step, cuts = 0.0, 0, float(dt), 0
-    if resume is not None:
-        x, t, v, a, fi, held, saved = resume_run(
-            resume, model, energy, hist, "newmark",
-            controller=("step", "steps", "cuts"))
-        step, steps, cuts = float(saved["step"]), int(saved["steps"]), \
-            int(saved["cuts"])
-        state = model.state(x)
-        fe = f_of(t)
-    solvers = {}
+        check_conditional_stability(model, m, x, run.free, dt, c.beta,
+                                    c.gamma, N == n_u)
+    stepper = _Newmark(run, c, t_end, dt, solver, callback)
+    stepper.start(x, v, resume)
     every = Every.of(checkpoint)
+    while stepper.t < t_end * (1 - 1e-12):
+        if stepper.advance() and every is not None:
+            stepper.save(every)
+    stepper.times["total"] = sum(stepper.times.values())
+    return Trajectory(stepper.x, stepper.v, stepper.a, stepper.t,
+                      stepper.hist, stepper.steps, dict(stepper.times))
 
-    def output(info=None, final=False):
-        out(t, x, v, state, held, final, dt=step, steps=steps, cuts=cuts,
-            active=int(held.sum()), iterations=0 if info is None else
-            len(info["residuals"]) - 1)
 
-    if resume is None:
-        output()
-    while t < t_end * (1 - 1e-12):
-        h = min(step, t_end - t)
-        ok, res = _step(run, c, (x, v, a, held), t, h, solver, solvers,
-                        times)
+class _Newmark:
+    """One Newmark run (:func:`newmark`): its state, the step controller
+    (a failed step is halved down to ``dt_min``, a step that converges in
+    a few iterations doubles back towards ``dt``) and the phases of a
+    step as methods; ``times`` holds the seconds of each
+    (:class:`~skfem_pg.solvers.dynamics.Timings`)."""
+
+    def __init__(self, run, controls, t_end, dt, solver, callback):
+        self.run, self.c, self.model = run, controls, run.model
+        self.t_end, self.dt, self.solver = t_end, float(dt), solver
+        self.dt_min = dt / 1024 if controls.dt_min is None \
+            else controls.dt_min
+        self.callback = callback
+        self.times = Timings(("assemble", "linear", "output", "contact"))
+        self.solvers = {}  # the condensed solver of the active set
+        self.t, self.steps, self.step, self.cuts = 0.0, 0, float(dt), 0
+
+    def start(self, x, v, resume):
+        """The state at ``t = 0`` (or of the checkpoint ``resume``), the
+        energy account and the first output."""
+        run, model, n_u = self.run, self.model, self.model.n_u
+        self.held = np.zeros(n_u, dtype=bool)
+        self.state = model.state(x)
+        self.fi = np.asarray(model.internal_force(self.state), dtype=float)
+        self.fe = run.f_of(0.0)
+        self.x, self.v = x, v
+        self.a = np.where(run.free, (self.fe[:n_u] - self.fi[:n_u])
+                          / run.m, 0.0)
+        self.energy = EnergyBalance(run.m, v, run.free,
+                                    stored_energy(model, self.state))
+        self.energy.D_c += hold_initial(run.walls, run.candidates, x, v,
+                                        self.a, run.m, self.held)
+        self.progress = Progress(self.t_end, self.c.verbose)
+        self.out = Recorder(model, self.energy, run.free, self.progress,
+                            self.callback, self.times)
+        self.hist = self.out.hist
+        if resume is None:
+            self.output()
+            return
+        self.x, self.t, self.v, self.a, self.fi, self.held, saved = \
+            resume_run(resume, model, self.energy, self.hist, "newmark",
+                       controller=("step", "steps", "cuts"))
+        self.step, self.steps, self.cuts = float(saved["step"]), int(
+            saved["steps"]), int(saved["cuts"])
+        self.state = model.state(self.x)
+        self.fe = run.f_of(self.t)
+
+    def output(self, info=None, final=False):
+        self.out(self.t, self.x, self.v, self.state, self.held, final,
+                 dt=self.step, steps=self.steps, cuts=self.cuts,
+                 active=int(self.held.sum()), iterations=0 if info is None
+                 else len(info["residuals"]) - 1)
+
+    def advance(self):
+        """Try one step; ``False`` if it failed and was halved."""
+        t, h = self.t, min(self.step, self.t_end - self.t)
+        ok, res = _step(self.run, self.c, (self.x, self.v, self.a,
+                                            self.held), t, h, self.solver,
+                        self.solvers, self.times)
         if not ok:
-            cuts += 1
-            step = h / 2
-            progress.echo("  t {:.6g}: step {:.3g} failed ({}); halved"
-                          .format(t + h, h, res))
-            if step < dt_min:
-                raise DynamicsError(
-                    "Newmark: no convergence at t = {:.6g} with the step "
-                    "{:.3g} < dt_min = {:.3g} ({})".format(
-                        t + h, step, dt_min, res),
-                    t=t, x=x, v=v, history=hist)
-            continue
-        xn, vn, an, fi_n, state, held_n, info = res
-        fe_n = f_of(t + h)
-        if commit(model, state, t + h, x, v, hist):
+            self.cut(h, res)
+            return False
+        self.accept(h, *res)
+        return True
+
+    def cut(self, h, reason):
+        """Halve the step after a failed one, down to ``dt_min``."""
+        self.cuts += 1
+        self.step = h / 2
+        self.progress.echo("  t {:.6g}: step {:.3g} failed ({}); halved"
+                           .format(self.t + h, h, reason))
+        if self.step < self.dt_min:
+            raise DynamicsError(
+                "Newmark: no convergence at t = {:.6g} with the step "
+                "{:.3g} < dt_min = {:.3g} ({})".format(
+                    self.t + h, self.step, self.dt_min, reason),
+                t=self.t, x=self.x, v=self.v, history=self.hist)
+
+    def accept(self, h, xn, vn, an, fi_n, state, held_n, info):
+        """Commit the history (a rebuild of the model's basis: the force
+        and acceleration of the new basis), book the energy, move on."""
+        run, model, n_u, t = self.run, self.model, self.model.n_u, self.t
+        fe_n = run.f_of(t + h)
+        if commit(model, state, t + h, self.x, self.v, self.hist):
             # the families were rebuilt: the force and the acceleration
             # of the new basis (lumped mass)
             state = model.state(xn)
             fi_n = np.asarray(model.internal_force(state), dtype=float)
-            an, moving = np.array(an), free & ~held_n
-            an[moving] = (fe_n[:n_u] - fi_n[:n_u])[moving] / m[moving]
-        touched = np.flatnonzero(held | held_n)
-        energy.step(xn - x, fi, fi_n, fe, fe_n, Dd, touched, v, vn,
-                    free & ~held, free & ~held_n)
-        x, v, a, fi, fe, held = xn, vn, an, fi_n, fe_n, held_n
-        t += h
-        steps += 1
-        if len(info["residuals"]) <= 5 and step < dt:
-            step = min(2 * step, dt)
-        final = t >= t_end * (1 - 1e-12)
-        if steps % c.output_every == 0 or final:
-            output(info, final)
-        if every is not None:
-            save_run(every, steps, model, x, t, v, a, fi, held, energy, hist,
-                     "newmark", step=step, steps=steps, cuts=cuts)
-    times["total"] = sum(times.values())
-    return Trajectory(x, v, a, t, hist, steps, times)
+            an, moving = np.array(an), run.free & ~held_n
+            an[moving] = (fe_n[:n_u] - fi_n[:n_u])[moving] / run.m[moving]
+        touched = np.flatnonzero(self.held | held_n)
+        self.energy.step(xn - self.x, self.fi, fi_n, self.fe, fe_n, run.D,
+                         touched, self.v, vn, run.free & ~self.held,
+                         run.free & ~held_n)
+        self.x, self.v, self.a, self.fi, self.fe, self.held = \
+            xn, vn, an, fi_n, fe_n, held_n
+        self.state = state
+        self.t += h
+        self.steps += 1
+        if len(info["residuals"]) <= 5 and self.step < self.dt:
+            self.step = min(2 * self.step, self.dt)
+        final = self.t >= self.t_end * (1 - 1e-12)
+        if self.steps % self.c.output_every == 0 or final:
+            self.output(info, final)
+
+    def save(self, every):
+        """A checkpoint, if ``every`` says it is due."""
+        save_run(every, self.steps, self.model, self.x, self.t, self.v,
+                 self.a, self.fi, self.held, self.energy, self.hist,
+                 "newmark", step=self.step, steps=self.steps,
+                 cuts=self.cuts)
 
 
 def _step(run, controls, start_state, t, h, solver, solvers, times):
