@@ -1,5 +1,5 @@
 """Local against global VC correction: accuracy on the same nodes and the
-correction's cost (``vc_solver="local"``, skfem_pg.discretization.local_vc).
+correction's cost (``vc_solver="local"``, skfem_pg.discretization.vc.local).
 
 1. **Manufactured solution** (thesis (7.7)–(7.8), full Dirichlet
    boundary, ±0.3h distorted quads and triangles): relative L2 and H1

@@ -18,7 +18,7 @@ True
 from . import (discretization, formulations, materials, solvers, analysis,
                scenes, threads, errors, registry)
 from .discretization import (particles, families, shape, corrections,
-                             loads)
+                             vc, loads)
 from .scenes import meshing, reference
 from .errors import (ParticleError, FamilyError, CorrectionError,
                      UnsupportedMeshError, SlowAssemblyWarning,
@@ -40,7 +40,7 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "block_pattern", "traction", "stress_load", "body_force",
            "write_vtu", "discretization", "formulations", "materials",
            "solvers", "analysis", "scenes", "families", "shape",
-           "corrections", "meshing", "particles", "loads",
+           "corrections", "vc", "meshing", "particles", "loads",
            "ParticleError", "FamilyError", "CorrectionError",
            "UnsupportedMeshError", "registry", "register_formulation",
            "Scene", "newton", "newmark", "central_difference",

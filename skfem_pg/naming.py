@@ -15,7 +15,7 @@ A name reads ``[VC|VC2][BC]{PBG|PPG|PPG1|PPG2} [V1..V5][p|s|sn|m]
 ``PBG``     Bubnov–Galerkin; ``PPG`` = ``PPG1`` Petrov–Galerkin (4.21),
             ``PPG2`` (4.22)
 ``p s sn``  boundary conditions of the VC system
-            (:mod:`skfem_pg.discretization.vc_boundary`); **default** ``sn``,
+            (:mod:`skfem_pg.discretization.vc.boundary`); **default** ``sn``,
             as in Table 7.1.  ``m`` (a package extension) is the package's
             minimum-norm solve
 ``U1``      WTE1 (classical correspondence), ``Unl`` MTE1, ``U2`` WTE2

@@ -7,7 +7,7 @@ from skfem.helpers import ddot, sym_grad
 
 import skfem_pg as pg
 from skfem_pg.analysis import PATCH_GRADIENT_2D as GEX
-from skfem_pg.discretization.corrections import anchor_particles
+from skfem_pg.discretization.vc.first_order import anchor_particles
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
 from conftest import square
@@ -125,7 +125,7 @@ def test_amg_vc_solve_equals_the_lu(dim, monkeypatch):
     correction (measured 1.9e-11 relative on 3.4k gmsh tets), and "auto"
     takes it in 3-D above AMG_VC_LIMIT_3D particles."""
     import skfem as fem
-    from skfem_pg import corrections
+    from skfem_pg.discretization.vc import first_order
     g = np.linspace(0, 1, 9 if dim == 2 else 6)
     mesh = (fem.MeshTri if dim == 2 else fem.MeshTet).init_tensor(
         *([g] * dim))
@@ -136,7 +136,7 @@ def test_amg_vc_solve_equals_the_lu(dim, monkeypatch):
     assert amg.vc_report.solver == "amg"
     assert np.abs(amg.G - direct.G).max() <= 1e-10 * np.abs(direct.G).max()
     assert amg.vc_report.residual_after < 1e-10
-    monkeypatch.setattr(corrections, "AMG_VC_LIMIT_3D", 10)
+    monkeypatch.setattr(first_order, "AMG_VC_LIMIT_3D", 10)
     auto = pg.FamilyBasis(p, dim=dim)
     assert auto.vc_report.solver == ("amg" if dim == 3 else "direct")
 

@@ -35,3 +35,14 @@ def test_the_examples_are_there():
                  "skfem_pg.solvers.problem"):
         assert counted[name] > 0, name
     assert sum(counted.values()) >= 60
+
+
+def test_every_module_is_in_the_api_reference():
+    """docs/api.rst lists every module of the package (a module added
+    without it is missing from the reference)."""
+    import pathlib
+    import re
+    api = (pathlib.Path(__file__).resolve().parents[1] / "docs"
+           / "api.rst").read_text()
+    listed = set(re.findall(r"automodule:: (\S+)", api))
+    assert [m for m in MODULES if m not in listed] == []

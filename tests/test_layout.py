@@ -118,8 +118,9 @@ def test_fd_tangent_on_flat_and_padded_state():
 def test_unpadded_pipeline_equals_padded(boundary, families):
     """The default PBG pipeline (MTE1, bond, V5) runs per size group; the
     same kernels on the padded arrays give the same derivatives."""
-    from skfem_pg.discretization.corrections import (
-        VCSystem, bond_correction, correction_functions, vc_correction)
+    from skfem_pg.discretization.corrections import bond_correction
+    from skfem_pg.discretization.vc import (VCSystem, correction_functions,
+                                            vc_correction)
     from skfem_pg.discretization.quadrature import weight_rule
     from skfem_pg.discretization.shape import GRADIENTS
     p = pg.Particles.from_mesh(cube(3, 0.3, kind="tet"))

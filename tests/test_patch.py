@@ -179,7 +179,7 @@ def test_vc2_ppg_v1s_u2_passes_the_quadratic_patch_test():
     assert np.sum(lam < -1e-8 * np.abs(lam).max()) >= 1
     # the constraints hold in the bond-pair (element) view that assembles
     # PPG1, not only in the master view they were solved in
-    from skfem_pg.discretization.vc2 import vc2_residuals
+    from skfem_pg.discretization.vc.second_order import vc2_residuals
     b = r["basis"]
     p = b.particles
     r1, r2 = vc2_residuals(b.test.G, b.dx, b.families, p.x, p.volumes,

@@ -6,7 +6,7 @@ import pytest
 import skfem_pg as pg
 from skfem_pg.discretization import petrov
 from skfem_pg.analysis import linear_patch_test
-from skfem_pg.discretization.corrections import constraint_residual
+from skfem_pg.discretization.vc.first_order import constraint_residual
 from skfem_pg.materials import lame
 from skfem_pg.formulations import linear_elasticity
 from conftest import square, cube

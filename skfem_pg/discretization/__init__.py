@@ -14,8 +14,11 @@ systems.
                            basis uses by default (thesis', meshU or kNN)
 ``quadrature``             PBG quadrature weights (volume (4.30), uniform)
 ``shape``                  WTE1/MTE1, WTE2, least-squares and LME derivatives
-``corrections``            bond (5.55) and VC (5.57)–(5.64) corrections;
-                           ``vc_boundary``, ``vc2``: boundary variants, VC2
+``corrections``            the bond correction (5.55) and the check of a
+                           corrected basis
+``vc``                     variationally consistent corrections (5.2): the
+                           first-order system (:class:`VCSystem`), boundary
+                           variants, VC2, local VC
 ``petrov``                 PPG test bases (4.21), (4.22)
 ``layout``                 families grouped by size (unpadded hot paths)
 ``parts``                  the parts of a basis (family rule, shape,

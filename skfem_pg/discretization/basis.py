@@ -177,7 +177,7 @@ class FamilyBasis(AbstractBasis):
         ``tests/test_eigen.py``), off for WTE1.
     vc
         Variationally consistent correction
-        (:func:`~skfem_pg.discretization.corrections.correction_functions`):
+        (:func:`~skfem_pg.discretization.vc.first_order.correction_functions`):
         ``"V5"`` (default with bond correction), ``"V3"`` (default for MTE1
         without bond correction, for WTE2 and for PPG, whose test derivatives
         it corrects), ``"V4"`` (keeps quadratic consistency), ``"V2"``
@@ -187,7 +187,7 @@ class FamilyBasis(AbstractBasis):
         ``"VC2"`` (second-order VC for ``shape="WTE2"``: PBG with V4
         correction functions, PPG1 (5.24) with V1 ones on its test
         derivatives; passes the quadratic patch test;
-        :mod:`skfem_pg.discretization.vc2`).
+        :mod:`skfem_pg.discretization.vc.second_order`).
     method
         ``"PBG"`` (Peridynamic Bubnov–Galerkin, symmetric; default),
         ``"PPG1"`` or ``"PPG2"`` (Peridynamic Petrov–Galerkin (4.21),
@@ -207,7 +207,7 @@ class FamilyBasis(AbstractBasis):
         LU), ``"amg"`` (the same scalar system by AMG-GMRES, linear in
         the particle count) or ``"lsqr"``; on a distributed basis also
         ``"petsc"`` (:mod:`skfem_pg.distributed.vc`: solved on all ranks).
-        ``"local"`` (:mod:`skfem_pg.discretization.local_vc`, the thesis'
+        ``"local"`` (:mod:`skfem_pg.discretization.vc.local`, the thesis'
         outlook 8.2) solves no global system: each family meets its share
         :math:`\\int N_k \\nabla N_i` of the constraint (the collocation
         mesh's linear functions), one :math:`d\\times d` solve per family
@@ -226,7 +226,7 @@ class FamilyBasis(AbstractBasis):
         quadratic patch test.  Uses the LSQR solve.
     vc_boundary
         Boundary conditions of the (singular) first-order VC system,
-        :mod:`skfem_pg.discretization.vc_boundary`: ``"min-norm"`` (default;
+        :mod:`skfem_pg.discretization.vc.boundary`: ``"min-norm"`` (default;
         every constraint with FE-consistent :math:`A^i`), or the thesis'
         ``"p"``, ``"s"``, ``"sn"``.  With ``"s"``/``"sn"`` the surface
         particles' discrete area vectors (4.35) differ from FE's by
@@ -289,7 +289,7 @@ class FamilyBasis(AbstractBasis):
         :func:`skfem_pg.discretization.petrov.element_test_gradients`);
         ``None`` for PBG.
     vc_report
-        :class:`~skfem_pg.discretization.corrections.VCReport` (``None``
+        :class:`~skfem_pg.discretization.vc.first_order.VCReport` (``None``
         without VC).
     area_correction
         ``(dim, np)`` discrete minus FE-consistent surface area vectors

@@ -48,8 +48,8 @@ from . import families as families_mod
 from . import petrov
 from . import recipes
 from ..errors import FamilyError, describe_particle
-from .corrections import (VCSystem, bond_correction, check_correction,
-                          correction_functions, vc_correction)
+from .corrections import bond_correction, check_correction
+from .vc.first_order import VCSystem, correction_functions, vc_correction
 from .families import Families
 from .quadrature import weight_rule
 from .shape import GRADIENTS
@@ -57,10 +57,10 @@ from .shape.least_squares import (mls1_master_gradients,
                                    wls1_master_gradients,
                                    wls2_master_gradients)
 from .shape.lme import lme_master_gradients
-from .vc2 import vc2_correction
+from .vc.second_order import vc2_correction
 from .moment_quadrature import moment_quadrature
 from .moment_quadrature import family_options as moment_family_options
-from . import local_vc
+from .vc import local as local_vc
 from . import parts as parts_mod
 from ..naming import GIVEN, name_of, parse
 
@@ -352,7 +352,7 @@ class _Context:
                                     n=self.spec.weight_exponent)
 
     def system(self, G, dx, variant):
-        """The :class:`~skfem_pg.discretization.corrections.VCSystem` of
+        """The :class:`~skfem_pg.discretization.vc.first_order.VCSystem` of
         derivatives ``G`` with weights ``dx`` and the correction functions
         of ``variant``."""
         p = self.particles

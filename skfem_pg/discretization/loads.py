@@ -11,7 +11,7 @@ functions of the facets the particles were collocated from (4.31)–(4.35):
 
 Because the same :math:`A^i` enter the VC correction, a linear field is
 reproduced exactly (patch test).  With the thesis' VC boundary variants
-``s``/``sn`` (:mod:`skfem_pg.discretization.vc_boundary`) the surface
+``s``/``sn`` (:mod:`skfem_pg.discretization.vc.boundary`) the surface
 particles' discrete area vectors (4.35) differ from the FE ones by
 ``basis.area_correction``; the loads then use the discrete vectors (4.32), the
 correction at a particle shared in proportion to the part of its area vector

@@ -43,7 +43,7 @@ CAPABILITIES = {
     "grouped": "the stages run per family-size group, without padding "
                "(builder)",
     "mpi": "a rank's part of a distributed basis (Partition.basis)",
-    "local_vc": "vc_solver='local' (skfem_pg.discretization.local_vc)",
+    "local_vc": "vc_solver='local' (skfem_pg.discretization.vc.local)",
     "crack_rebuild": "crack-aware families rebuilt from the intact cells "
                      "(skfem_pg.formulations.crack_aware)",
     "updated_lagrangian": "rebuilt on moved particles, the history "
@@ -52,7 +52,7 @@ CAPABILITIES = {
 
 METHODS = ("PBG", "PPG1", "PPG2")
 #: the VC variants each kind of method accepts
-#: (:func:`~skfem_pg.discretization.corrections.correction_functions`)
+#: (:func:`~skfem_pg.discretization.vc.first_order.correction_functions`)
 VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
                "PPG": ("V1", "V2", "V3", "V4", "VC2")}
 #: family rules with no parameters that may be named
@@ -260,7 +260,7 @@ class Correction(Part):
     """The corrections of the derivatives: the bond correction (5.55) and
     a variationally consistent one (``vc``: ``"V1"``…``"V5"``,
     ``"VC2"`` or ``None``) with the VC system's ``boundary``
-    (:mod:`~skfem_pg.discretization.vc_boundary`), ``solver``, the
+    (:mod:`~skfem_pg.discretization.vc.boundary`), ``solver``, the
     particles it ``exclude``\\ s and the residual ``tolerance`` it
     accepts."""
 
@@ -320,7 +320,7 @@ class Correction(Part):
             why = refusal("local_vc", parts)
             if why is not None:
                 return NotBuilt("vc_solver='local' "
-                                "(skfem_pg.discretization.local_vc): "
+                                "(skfem_pg.discretization.vc.local): "
                                 + why)
         return None
 

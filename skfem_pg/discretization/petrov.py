@@ -38,7 +38,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
-from .corrections import VCReport, constraint_residual
+from .vc.first_order import VCReport, constraint_residual
 from .families import Families
 
 

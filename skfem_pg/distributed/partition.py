@@ -24,7 +24,7 @@ scikit-fem).  :meth:`Partition.l2g` maps local dofs to these global dofs,
 serial numbering on every rank.
 
 The VC correction couples all families through one sparse system
-(:func:`~skfem_pg.discretization.corrections.vc_correction`).  Its pieces
+(:func:`~skfem_pg.discretization.vc.first_order.vc_correction`).  Its pieces
 are rank-local — each rank's families give their columns of the scalar
 constraint matrix :math:`\Phi^T`, their :math:`B^k` and their part of
 the residual, summed over ranks — and rank 0 solves the assembled system

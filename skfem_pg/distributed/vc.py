@@ -31,9 +31,9 @@ from scipy.sparse.csgraph import connected_components
 
 from . import petsc as pt
 from .comm import mpi, petsc, raise_together
-from ..discretization.local_vc import (family_shares, local_vc_correction,
+from ..discretization.vc.local import (family_shares, local_vc_correction,
                                        smoothed_gradients)
-from ..discretization.corrections import (
+from ..discretization.vc.first_order import (
     AMG_VC_LIMIT_3D, VCReport, solve_pinned_lu, anchor_particles,
     linear_fields, scalar_constraint_matrix, vc_apply, vc_parts,
     vc_residual)
@@ -165,10 +165,10 @@ def solve_pinned(part, rows, cols, vals, fid, B, b, anchors, min_norm=True):
 
 def vc_correction(part, system, variant="V5", solver="auto", exclude=None,
                   boundary="min-norm"):
-    """:func:`~skfem_pg.discretization.corrections.vc_correction` of the
+    """:func:`~skfem_pg.discretization.vc.first_order.vc_correction` of the
     families of partition ``part`` with the global constraint system
     (:mod:`~skfem_pg.distributed.partition`): ``system`` (a
-    :class:`~skfem_pg.discretization.corrections.VCSystem`) holds the
+    :class:`~skfem_pg.discretization.vc.first_order.VCSystem`) holds the
     local arrays, as the basis passes them.  ``solver`` ``"direct"``/``"amg"``
     (``"auto"``): rank 0 solves the gathered system with the serial code;
     ``"petsc"``: all ranks (:func:`solve_pinned`)."""
@@ -259,7 +259,7 @@ def _finish(part, parts, Qs, alpha, r0, grouped, variant, solver, nf, its,
 
 def local_solver(part):
     """The ``vc_solve`` of a rank's basis with ``vc_solver="local"``
-    (:func:`skfem_pg.discretization.local_vc.local_vc_correction`): the
+    (:func:`skfem_pg.discretization.vc.local.local_vc_correction`): the
     shares of the partition's owned masters on the replicated mesh, the
     residual summed over the ranks, an error of one rank's families
     raised on every rank — no other communication."""

@@ -59,9 +59,9 @@ import numpy as np
 import scipy.sparse as sp
 import skfem as fem
 
-from ..errors import CorrectionError, describe_particle
-from .corrections import VCReport, vc_parts, vc_residual
-from .particles import linear_elements
+from ...errors import CorrectionError, describe_particle
+from .first_order import VCReport, vc_parts, vc_residual
+from ..particles import linear_elements
 
 
 def smoothed_gradients(mesh, elements=None, rows=None):
@@ -138,8 +138,8 @@ def local_vc_correction(system, variant="V5", boundary="min-norm",
     the integration constraint (module docstring).
 
     The arguments are those of
-    :func:`~skfem_pg.discretization.corrections.vc_correction` (of the
-    :class:`~skfem_pg.discretization.corrections.VCSystem`, ``phi`` is
+    :func:`~skfem_pg.discretization.vc.first_order.vc_correction` (of the
+    :class:`~skfem_pg.discretization.vc.first_order.VCSystem`, ``phi`` is
     not used: the local correction has one vector per family and shape
     function); ``shares`` is ``f(masters, mem, mask) -> (nf, m, d)`` (the
     caller's :func:`family_shares` on its mesh, in the numbering of

@@ -2,7 +2,7 @@ r"""Boundary conditions of the VC correction system, thesis section 5.3
 (Table 7.1: ``p``, ``s``, ``sn``).
 
 The constraint system ``A α = b`` of a first-order VC correction
-(:func:`~skfem_pg.discretization.corrections.vc_correction`: rows = the
+(:func:`~skfem_pg.discretization.vc.first_order.vc_correction`: rows = the
 integration constraints (5.18) of the particles, ``d`` each; columns = the
 correction factors :math:`\alpha^k` of the families, ``d`` each) is singular:
 the consistency modes it preserves are zero eigenvalues (``d + d²`` for V3/V5).

@@ -36,7 +36,7 @@ unknowns with blocks :math:`\varphi^{ki} M^{ki}`,
 
 solved for its minimum-norm least-squares solution (LSQR; lengths scaled
 by the mean spacing), or, with the thesis' boundary variant ``s``
-(:mod:`skfem_pg.discretization.vc_boundary`), with all correction factors of
+(:mod:`skfem_pg.discretization.vc.boundary`), with all correction factors of
 surface particles fixed to zero and their constraints released: a square
 system, one sparse LU.  The surface particles' discrete :math:`A^i` and
 :math:`A_2^i` then differ from FE's (``VCReport.area_correction``,
@@ -49,8 +49,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
-from . import vc_boundary
-from .corrections import VCReport, constraint_residual
+from . import boundary as vc_boundary
+from .first_order import VCReport, constraint_residual
 
 
 def _first_moments(G, dx, fam, X):
@@ -157,7 +157,7 @@ def _blocks_to_csr(M, fam, d):
 def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
                    boundary="min-norm", method="PBG"):
     """Second-order VC correction of the PBG derivatives ``G`` of
-    ``system`` (a :class:`~skfem_pg.discretization.corrections.VCSystem`;
+    ``system`` (a :class:`~skfem_pg.discretization.vc.first_order.VCSystem`;
     quadratic consistent, e.g. WTE2; padded, ``index`` unused); ``area``
     :math:`A^i` ``(d, n)``, ``area2`` :math:`A_2^i` ``(d, d, n)`` about
     the origin 0, ``phi`` the correction function ``(nf, m)`` (V4; for
