@@ -10,10 +10,13 @@ import pytest
 
 GUIDE = pathlib.Path(__file__).resolve().parents[1] / "docs" / "guide" \
     / "contributing.md"
-BLOCKS = re.findall(r"```python\n(.*?)```", GUIDE.read_text(), re.S)
+BLOCKS = re.findall(r"```python\n(.*?)```", GUIDE.read_text(), re.S) \
+    if GUIDE.exists() else []
 
 
 def test_the_guide_has_its_recipes():
+    if not GUIDE.exists():
+        pytest.skip("the tests run outside the repository (no docs/)")
     assert len(BLOCKS) == 4
 
 

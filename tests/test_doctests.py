@@ -42,7 +42,9 @@ def test_every_module_is_in_the_api_reference():
     without it is missing from the reference)."""
     import pathlib
     import re
-    api = (pathlib.Path(__file__).resolve().parents[1] / "docs"
-           / "api.rst").read_text()
+    path = pathlib.Path(__file__).resolve().parents[1] / "docs" / "api.rst"
+    if not path.exists():
+        pytest.skip("the tests run outside the repository (no docs/)")
+    api = path.read_text()
     listed = set(re.findall(r"automodule:: (\S+)", api))
     assert [m for m in MODULES if m not in listed] == []

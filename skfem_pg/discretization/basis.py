@@ -300,6 +300,24 @@ class FamilyBasis(AbstractBasis):
     timings
         Seconds spent on families, gradients, bond and VC correction.
 
+    Examples
+    --------
+    The default basis of a mesh's vertices assembles scikit-fem's forms
+    like an FE basis on the same nodes (:func:`skfem_pg.assemble`: the
+    batched path; ``form.assemble(basis)`` works too, slower); the
+    stiffness matrix has the rigid-body modes as its null space:
+
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem.models.elasticity import linear_elasticity
+    >>> mesh = fem.MeshTri().refined(2)
+    >>> basis = FamilyBasis(mesh, dim=2)
+    >>> basis.name
+    'VCBCPBG V5m Unl TL meshU'
+    >>> K = pg.assemble(linear_elasticity(1.0, 1.0), basis)
+    >>> K.shape == (basis.N, basis.N), int(np.sum(np.linalg.eigvalsh(
+    ...     K.toarray()) < 1e-10))
+    (True, 3)
+
     """
 
     def __new__(cls, particles=None, *args, order: int = 1, **kwargs):

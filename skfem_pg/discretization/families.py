@@ -47,6 +47,17 @@ class Families:
     n_particles
         Size of the particle set the indices refer to.
 
+    Examples
+    --------
+    The mesh rule's families on a 3 x 3 grid of particles: a corner's family
+    holds its cell's four vertices, the centre's all nine:
+
+    >>> import skfem as fem, skfem_pg as pg
+    >>> p = pg.Particles.from_mesh(fem.MeshQuad().refined(1))
+    >>> fam = from_mesh(p)
+    >>> len(fam), int(fam.sizes.min()), int(fam.sizes.max())
+    (9, 4, 9)
+
     """
 
     def __init__(self, offsets, members, n_particles):

@@ -33,7 +33,24 @@ def _fast(form, base, ubasis, vbasis, kwargs):
 
 class BilinearForm(fem.BilinearForm):
     """:class:`skfem.BilinearForm` whose :meth:`assemble` uses
-    :func:`skfem_pg.assemble` where it can (module docstring)."""
+    :func:`skfem_pg.assemble` where it can (module docstring).
+
+    Examples
+    --------
+    The same form assembles on a family basis (batched) and on an FE basis:
+
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem.helpers import dot, grad
+    >>> @BilinearForm
+    ... def laplace(u, v, w):
+    ...     return dot(grad(u), grad(v))
+    >>> mesh = fem.MeshTri().refined(2)
+    >>> K = laplace.assemble(pg.FamilyBasis(mesh))
+    >>> K_fe = laplace.assemble(fem.Basis(mesh, fem.ElementTriP1()))
+    >>> K.shape == K_fe.shape, bool(abs(K.sum()) < 1e-10)
+    (True, True)
+
+    """
 
     _pg_fast = True
 
@@ -44,7 +61,19 @@ class BilinearForm(fem.BilinearForm):
 class LinearForm(fem.LinearForm):
     """:class:`skfem.LinearForm` whose :meth:`assemble` uses
     :func:`skfem_pg.assemble` where it can; on a Petrov–Galerkin family
-    basis it tests with ``basis.test`` (internal forces (4.21))."""
+    basis it tests with ``basis.test`` (internal forces (4.21)).
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> @LinearForm
+    ... def unit(v, w):
+    ...     return v
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2))
+    >>> round(float(unit.assemble(basis).sum()), 12)  # the domain's area
+    1.0
+
+    """
 
     _pg_fast = True
 

@@ -159,6 +159,16 @@ class Particles:
         Provenance, set by :meth:`from_mesh`.  ``mesh`` is needed for surface
         area vectors, boundary loads and ``get_dofs`` by facets.
 
+    Examples
+    --------
+    Particles collocated from a scikit-fem mesh: its vertices, with their
+    lumped volumes (the volumes add up to the domain's):
+
+    >>> import skfem as fem
+    >>> p = Particles.from_mesh(fem.MeshQuad().refined(2))
+    >>> p.n, p.dim, round(float(p.volumes.sum()), 12)
+    (25, 2, 1.0)
+
     """
 
     def __init__(self, x, volumes, mesh=None, kind="points", elements=None):

@@ -104,7 +104,16 @@ class FamilyRule(Part):
     :data:`~skfem_pg.discretization.families.RULES` with keyword
     ``parameters`` (sorted ``(key, value)`` pairs; the defaults of WTE2
     and of the moment quadrature have some), or given
-    :class:`~skfem_pg.Families` (``rule`` is the object)."""
+    :class:`~skfem_pg.Families` (``rule`` is the object).
+
+    Examples
+    --------
+    >>> FamilyRule("horizon", (("factor", 2.51),)).describe()
+    "'horizon' (factor=2.51)"
+    >>> FamilyRule("mesh").refusal("mpi", Parts()) is None
+    True
+
+    """
 
     rule: object
     parameters: tuple = ()
@@ -171,7 +180,14 @@ class Shape(Part):
     """The shape functions' derivatives: ``"MTE1"`` (moving Taylor
     expansion), ``"WTE1"`` (static, classical correspondence) or
     ``"WTE2"`` (second-order static), with bond weights
-    :math:`\\omega = 1/|\\Delta X|^{2n}`, ``n = weight_exponent``."""
+    :math:`\\omega = 1/|\\Delta X|^{2n}`, ``n = weight_exponent``.
+
+    Examples
+    --------
+    >>> Shape("WTE2").min_members(2), Shape("MTE1").min_members(3)
+    (6, 4)
+
+    """
 
     name: str = "MTE1"
     weight_exponent: float = 1.0
@@ -214,7 +230,15 @@ class Quadrature(Part):
     ``"uniform"`` (PPG integrates with the member volumes), or at the
     moment-matched points (``rule="moments"``,
     :mod:`~skfem_pg.discretization.moment_quadrature`), which make their
-    own weights."""
+    own weights.
+
+    Examples
+    --------
+    >>> q = Quadrature(rule="moments")
+    >>> print(q.conflict(Parts(quadrature=q)))  # MTE1 by default
+    family_quadrature='moments' integrates the quadratic fit WTE2 of PBG: pass shape='WTE2' (method='PBG'), got shape='MTE1', method='PBG'
+
+    """
 
     weights: str = "volume"
     rule: str = "members"
@@ -262,7 +286,15 @@ class Correction(Part):
     ``"VC2"`` or ``None``) with the VC system's ``boundary``
     (:mod:`~skfem_pg.discretization.vc.boundary`), ``solver``, the
     particles it ``exclude``\\ s and the residual ``tolerance`` it
-    accepts."""
+    accepts.
+
+    Examples
+    --------
+    >>> c = Correction(bond=False, vc="V5")
+    >>> print(c.conflict(Parts(correction=c)))
+    vc='V5' keeps the bond mapping and needs bond=True; use vc='V3' without bond correction
+
+    """
 
     bond: bool = True
     vc: Optional[str] = "V5"
@@ -345,7 +377,14 @@ class Correction(Part):
 class Method(Part):
     """``"PBG"`` (Bubnov–Galerkin) or ``"PPG1"`` / ``"PPG2"``
     (Petrov–Galerkin (4.21), (4.22)) with its test derivatives at the
-    masters (``test_shape``; ``lme_mu``: the locality of ``"LME"``)."""
+    masters (``test_shape``; ``lme_mu``: the locality of ``"LME"``).
+
+    Examples
+    --------
+    >>> print(Method("PPG2").refusal("updated_lagrangian", Parts()))
+    UL is built for PBG, not method='PPG2'
+
+    """
 
     name: str = "PBG"
     test_shape: str = "master"
@@ -394,7 +433,14 @@ class Method(Part):
 
 @dataclasses.dataclass(frozen=True)
 class Parts:
-    """The five parts, without the field's number of components."""
+    """The five parts, without the field's number of components.
+
+    Examples
+    --------
+    >>> [type(p).__name__ for p in Parts()]
+    ['Shape', 'Quadrature', 'Correction', 'Method', 'FamilyRule']
+
+    """
 
     family_rule: FamilyRule = dataclasses.field(
         default_factory=lambda: FamilyRule("mesh"))

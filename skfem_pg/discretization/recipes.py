@@ -28,52 +28,35 @@ recipe     families, weights, exponent                      default for
 =========  ===============================================  ===================
 
 Why ``kNN`` on tetrahedra.  A gmsh tetrahedral mesh gives a vertex 14
-neighbours on average and as many as 30, spread over the cells around it;
-the 1-ring family, weighted by member volumes, averages the strain energy
-of a bending field over a region reaching far beyond the master
-(:mod:`~skfem_pg.discretization.quadrature`), and VC PBG Unl is soft: on
-the linear 3-D Cook's membrane its corner error is +15 / +25 / +19 / +13 /
-+9.2 % at 615 / 1343 / 2254 / 4038 / 6813 nodes (O1: −30 / −18 / −14 /
-−8.8 / −6.3 %; against an O2 overkill on 25.5k nodes, itself within about
-0.1 %).  The nearest ten particles are the compact neighbourhood the
-moving Taylor expansion needs (at least nine others in general position;
-pairwise completion adds two on average); uniform weights keep the energy
-at the family instead of on its largest (farthest) members, and unit bond
-weights use the few members evenly.  Each choice alone helps little
-(uniform weights on 1-ring families: +7.8 % at 2254 nodes; ten nearest
-with volume weights: +5.1 %, stalling there); together they converge from
-below like FE: −18 / −3.1 / −1.7 / +0.4 / −0.03 % on the same node sets
-(the tables ``recipes_3d_*`` in ``benchmarks/README.md``, written by
+neighbours on average and up to 30, spread over the cells around it. The
+1-ring family, weighted by member volumes, averages the strain energy of a
+bending field over a region that reaches far beyond the master, and VC PBG
+Unl is soft. The nearest ten particles are the compact neighbourhood that
+the moving Taylor expansion needs (at least nine others in general
+position). Uniform weights keep the energy at the family, not on its
+largest (farthest) members, and unit bond weights use the few members
+evenly. Each choice alone helps little. Together they converge from below,
+like FE, on the 3-D Cook membrane, beams and plates (tables
+``recipes_3d_*`` in ``benchmarks/README.md``, written by
 ``benchmarks/recipes_3d.py``).
 
 Why ``meshU`` on triangles.  The same two weight choices on the 1-ring
-families of a 2-D triangle mesh (issue 45; ``benchmarks/recipes_2d.py``,
-tables ``recipes_2d_*`` in ``benchmarks/README.md``): in plane strain
-against T2 overkills, compliance errors at about 3,000 nodes (+ = soft)
-of +0.16 % (curved cantilever), +0.19 % (straight cantilever), −0.64 %
-(L bracket) and −0.01 % (plate with an elliptic hole, tension), against
-T1's −0.64 / −0.53 / −1.45 / −0.18 % and the thesis recipe's +0.79 /
-+0.94 / +0.56 / +0.07 %: 0.06–0.44 times T1's error, the same sign at
-every refinement.  On Poisson problems it is stiff: −0.16 / −0.35 /
-−0.43 % (square, L bracket, disk) against P1's −0.11 / −0.42 / −0.12 %.
-The nearest-neighbour families, with or without equidistant ties, are
-no better there and change sign under refinement.
+families of a 2-D triangle mesh are soft by a fraction of T1's error, with
+the same sign at every refinement, in plane-strain bending and tension.
+On Poisson problems they are stiff, about as far off as P1. Families of
+nearest neighbours are no better there and change sign under refinement
+(issue 45; ``benchmarks/recipes_2d.py``, section "2-D recipes" of
+``benchmarks/README.md``).
 
-On quadrilaterals and hexahedral grids no recipe of MTE1 is robustly
-better than the thesis' (the study's tables: on gmsh quadrilaterals the
-best variant per geometry is 0.14–1.6 times Q1's error, and the winner
-changes with the geometry; on mapped quadrilaterals of the curved
-cantilever all are worse than Q1 or change sign), so ``mesh`` stays their
-default; in bending on coarse node sets it is soft (a 5 × 1 × 1
-hexahedral beam, 525 nodes: tip +38 %, H1 −3.4 %,
-``tests/test_gallery.py``; the plane-strain cantilever of
-``docs/examples/ex02_cantilever.py``, 297 nodes: +6.5 %, Q1 −2.2 %).
-What is robustly better there is not a recipe but another quadrature:
-the quadratic fit WTE2 at moment-matched points
-(``shape="WTE2", family_quadrature="moments"``,
-:mod:`~skfem_pg.discretization.moment_quadrature`; 0.09–0.41 times Q1's
-error, 0.05 times H1's on the hex beam), opt-in until the thesis'
-formulations are measured on it.
+On quadrilaterals and hexahedral grids, no recipe of MTE1 is robustly
+better than the thesis' (the winner changes with the geometry), so
+``mesh`` stays their default. In bending on coarse node sets it is soft
+(``tests/test_gallery.py``; ``docs/examples/ex02_cantilever.py``). What is
+robustly better there is not a recipe but another quadrature: the
+quadratic fit WTE2 at moment-matched points (``shape="WTE2",
+family_quadrature="moments"``,
+:mod:`~skfem_pg.discretization.moment_quadrature`), which is opt-in until
+the thesis' formulations are measured on it.
 
 The Table 7.1 names mean what the thesis means (``mesh``);
 the package tokens ``kNN`` and ``meshU`` at the end of a name select

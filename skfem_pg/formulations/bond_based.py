@@ -146,6 +146,16 @@ class BondBased:
         arrays of bond ends, returning ``nb`` booleans) is true are
         broken from the start, e.g. :func:`segment_cut` for a notch in
         2-D.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(3), dim=2)
+    >>> model = BondBased(basis, E=1000.0)
+    >>> state = model.state(np.zeros(model.N))
+    >>> float(np.abs(model.internal_force(state)).max())
+    0.0
+
     """
 
     name = "PMB"

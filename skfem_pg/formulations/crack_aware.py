@@ -371,7 +371,27 @@ class CrackAware(_Crack, Hyperelastic):
     cells, ``model.intact`` the mask of the mesh's intact cells.
     ``updates``, ``update_seconds`` and ``update_log`` (per update: the
     cells failed and the seconds) say how often the families were rebuilt
-    and what it cost."""
+    and what it cost.
+
+    Examples
+    --------
+    The mesh families of a block, with a Johnson–Cook damage law: before
+    anything fails every cell is intact and the model is the plain
+    displacement formulation:
+
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
+    ...                                 JohnsonCookHardening)
+    >>> steel = J2Plasticity.from_young(
+    ...     200e3, 0.29, hardening=JohnsonCookHardening(792.0, 510.0, 0.26),
+    ...     damage=JohnsonCookDamage(0.05, 3.44, -2.12, 0.3))
+    >>> mesh = fem.MeshQuad().refined(2)
+    >>> basis = pg.FamilyBasis(mesh, "mesh", dim=2)
+    >>> model = CrackAware(basis, steel)
+    >>> bool(model.intact.all()), model.updates
+    (True, 0)
+
+    """
 
     _gradient_key = "F"
 

@@ -93,6 +93,16 @@ class MeanDilatation(Hyperelastic):
     ``fields(u)`` gives, per element (family), the pressure ``p`` and
     dilatation ``Theta`` at the centroid (order 1 also their gradients
     ``p_grad``, ``Theta_grad``, ``(n, d)``).
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> model = MeanDilatation(basis, mu=40.0, K=100.0)
+    >>> state = model.state(np.zeros(model.N))
+    >>> model.N == basis.N, float(np.abs(model.internal_force(state)).max())
+    (True, 0.0)
+
     """
 
     def __init__(self, basis, mu, K, order=0):

@@ -85,6 +85,17 @@ class Hyperelastic:
     bound to the model's integration points: ``model.history`` holds its
     committed internal variables, per family member :math:`(k, j)` on a
     family basis, per Gauss point on a scikit-fem basis.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem_pg.materials import NeoHooke
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> model = Hyperelastic(basis, NeoHooke(60.0, 40.0))
+    >>> state = model.state(np.zeros(model.N))
+    >>> float(np.abs(model.internal_force(state)).max()), model.min_J(state)
+    (0.0, 1.0)
+
     """
 
     def __init__(self, basis, material, tangent="consistent"):

@@ -66,6 +66,15 @@ class IncompressibleP0(Hyperelastic):
     isochoric neo-Hooke with shear modulus ``mu``.
 
     ``fields(x)`` gives the per-element (per-family) pressure ``p``.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> model = IncompressibleP0(basis, mu=40.0)
+    >>> model.N > model.n_u == basis.N  # the pressures follow the displacements
+    True
+
     """
 
     def __init__(self, basis, mu):

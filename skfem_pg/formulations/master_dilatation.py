@@ -48,7 +48,17 @@ class MasterDilatation(Hyperelastic):
     iso/vol neo-Hooke with shear modulus ``mu`` and bulk modulus ``K``.
 
     ``fields(u)``: the pressure ``p`` and dilatation ``Theta`` (= J at the
-    master) per particle."""
+    master) per particle.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2, method="PPG1")
+    >>> model = MasterDilatation(basis, mu=40.0, K=100.0)
+    >>> model.N == basis.N
+    True
+
+    """
 
     #: VC boundary variants with which it is unstable in 3-D (refused)
     unstable_3d = ("min-norm", "p")
@@ -189,7 +199,17 @@ class MasterIncompressible(MasterDilatation):
 
     Unknowns ``[u, p]``, one p per particle (family); the tangent is a
     non-symmetric saddle point (zero p-p block: the direct solver's
-    COLAMD path).  Isochoric neo-Hooke with shear modulus ``mu``."""
+    COLAMD path).  Isochoric neo-Hooke with shear modulus ``mu``.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2, method="PPG1")
+    >>> model = MasterIncompressible(basis, mu=40.0)
+    >>> model.N - model.n_u == len(basis.families)  # a pressure per family
+    True
+
+    """
 
     unstable_3d = ()  # not measured unstable with any VC variant
 

@@ -89,6 +89,15 @@ class NodalPressure(Hyperelastic):
 
     ``fields(x)`` gives the nodal ``p`` and ``Theta`` and, with the bubble,
     its amplitude ``bubble`` per family ``(n_f, d)``.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> model = NodalPressure(basis, mu=40.0, K=100.0)
+    >>> (model.N - model.n_u) // basis.particles.n  # p and Theta
+    2
+
     """
 
     def __init__(self, basis, mu, K, bubble=True):

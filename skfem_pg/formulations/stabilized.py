@@ -300,7 +300,19 @@ class U1SUnl(_MasterModel):
     """U1SUnl (6.18)–(6.20) on the MTE1 (Unl) ``basis``; the
     under-integrated WTE1 part on :func:`under_integrated` of it (VC done
     twice, as the thesis says).  ``basis`` is the model's basis (dofs,
-    loads)."""
+    loads).
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> from skfem_pg.materials import NeoHooke
+    >>> model = U1SUnl(basis, NeoHooke(60.0, 40.0))
+    >>> state = model.state(np.zeros(model.N))
+    >>> float(np.abs(model.internal_force(state)).max())
+    0.0
+
+    """
 
     name = "U1SUnl"
 
@@ -366,7 +378,20 @@ class U1SUnl(_MasterModel):
 
 class U1SIG(_MasterModel):
     """U1SIG (6.21)–(6.28) on the under-integrated WTE1 ``basis``
-    (:func:`under_integrated` of the given one)."""
+    (:func:`under_integrated` of the given one).
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> from skfem_pg.materials import NeoHooke
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2, shape="WTE1",
+    ...                        bond=False)
+    >>> model = U1SIG(basis, NeoHooke(60.0, 40.0))
+    >>> state = model.state(np.zeros(model.N))
+    >>> float(np.abs(model.internal_force(state)).max())
+    0.0
+
+    """
 
     name = "U1SIG"
 

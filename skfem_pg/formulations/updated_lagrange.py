@@ -101,7 +101,18 @@ class UpdatedLagrange(Hyperelastic):
 
     ``model.basis`` stays the reference basis (dofs, loads, Dirichlet
     boundaries: the particle numbering does not change);
-    ``model.current`` is the basis of the last update."""
+    ``model.current`` is the basis of the last update.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> from skfem_pg.materials import NeoHooke
+    >>> model = UpdatedLagrange(basis, NeoHooke(60.0, 40.0), every=2)
+    >>> model.N == basis.N, model.every
+    (True, 2)
+
+    """
 
     def __init__(self, basis, material, every=1):
         if not isinstance(basis, FamilyBasis):

@@ -33,6 +33,13 @@ class LinearSaturation:
         below ``sigma_y0``).
     delta
         Saturation exponent (:math:`\ge 0`).
+
+    Examples
+    --------
+    >>> law = LinearSaturation(sigma_y0=5.0, H=10.0)
+    >>> float(law.stress(0.1))
+    6.0
+
     """
 
     def __init__(self, sigma_y0, H=0.0, sigma_yinf=None, delta=0.0):

@@ -103,7 +103,17 @@ class Material:
 class LinearElastic(Material):
     r"""Small-strain linear elasticity as a function of ``F``:
     :math:`\varepsilon = \mathrm{sym}(F - I)`,
-    :math:`P = \lambda\,\mathrm{tr}\varepsilon\, I + 2\mu\varepsilon`."""
+    :math:`P = \lambda\,\mathrm{tr}\varepsilon\, I + 2\mu\varepsilon`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> m = LinearElastic(lam=60.0, mu=40.0)
+    >>> F = np.eye(2)[:, :, None] + np.array([[1e-3, 0], [0, 0]])[:, :, None]
+    >>> m.stress(F)[:, :, 0].round(6).tolist()
+    [[0.14, 0.0], [0.0, 0.06]]
+
+    """
 
     small_strain = True
 
@@ -137,7 +147,16 @@ class LinearElastic(Material):
 
 class StVenantKirchhoff(Material):
     r"""St. Venant–Kirchhoff (2.45): :math:`S = \lambda\,\mathrm{tr}E\,I +
-    2\mu E`, :math:`P = FS`."""
+    2\mu E`, :math:`P = FS`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> m = StVenantKirchhoff(lam=60.0, mu=40.0)
+    >>> float(m.energy(np.eye(3)[:, :, None])[0])
+    0.0
+
+    """
 
     def __init__(self, lam, mu):
         self.lam, self.mu = check_moduli(lam=lam, mu=mu)
@@ -171,7 +190,20 @@ class NeoHooke(Material):
     r"""Compressible neo-Hooke (2.42):
     :math:`W = \frac\mu2(\mathrm{tr}C - 3 - 2\ln J)
     + \frac\lambda4(J^2 - 1 - 2\ln J)`,
-    :math:`P = \mu(F - F^{-T}) + \frac\lambda2(J^2 - 1)F^{-T}`."""
+    :math:`P = \mu(F - F^{-T}) + \frac\lambda2(J^2 - 1)F^{-T}`.
+
+    Examples
+    --------
+    The arguments are Lamé's constants, ``lam`` first; at ``F = I`` the
+    stress vanishes and the tangent is the linear one:
+
+    >>> import numpy as np
+    >>> m = NeoHooke(lam=60.0, mu=40.0)
+    >>> F = np.eye(3)[:, :, None]
+    >>> float(np.abs(m.stress(F)).max()), float(m.tangent(F)[0, 0, 0, 0, 0])
+    (0.0, 140.0)
+
+    """
 
     def __init__(self, lam, mu):
         self.lam, self.mu = check_moduli(lam=lam, mu=mu)
@@ -203,7 +235,19 @@ class NeoHookeIsoVol(Material):
     :math:`W = \frac\mu2(\mathrm{tr}\,b_{iso} - 3)
     + \frac K4(J^2 - 1 - 2\ln J)`, :math:`b_{iso} = J^{-2/3} b`,
     :math:`K = \lambda + \frac23\mu`.  In 2-D: plane strain,
-    :math:`\mathrm{tr}\,b = \mathrm{tr}\,b_{2D} + 1`."""
+    :math:`\mathrm{tr}\,b = \mathrm{tr}\,b_{2D} + 1`.
+
+    Examples
+    --------
+    Shear and bulk modulus, ``mu`` first (:meth:`from_lame` takes Lamé's
+    constants):
+
+    >>> m = NeoHookeIsoVol(mu=40.0, K=100.0)
+    >>> n = NeoHookeIsoVol.from_lame(60.0, 40.0)
+    >>> round(n.K, 6), n.mu
+    (86.666667, 40.0)
+
+    """
 
     def __init__(self, mu, K):
         self.mu, self.K = check_moduli(mu=mu, K=K)

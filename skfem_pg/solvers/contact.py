@@ -28,7 +28,18 @@ class RigidWall:
     """The plane ``x[axis] = position``, the body on ``side`` of it.
 
     ``tol``: the penetration (a length) below which a dof counts as on the
-    wall; default 1e-9 of the body's extent along ``axis``."""
+    wall; default 1e-9 of the body's extent along ``axis``.
+
+    Examples
+    --------
+    The plane ``y = 0`` with the body above it (``side=1``); a driver binds a
+    copy of it to each run (``Problem(..., walls=wall)``):
+
+    >>> wall = RigidWall(axis=1, position=0.0, side=1)
+    >>> wall
+    RigidWall(axis=1, position=0.0, side=+1)
+
+    """
 
     def __init__(self, axis, position=0.0, side=1, tol=None):
         if side not in (1, -1):

@@ -100,6 +100,16 @@ class NewtonControls(Controls):
         (:class:`~skfem_pg.solvers.static.KeptTangent`).  A step then
         doubles the next one when it needed at most 2 fresh tangents
         (the history's ``tangents``).
+
+    Examples
+    --------
+    A record, or its fields as keywords of the driver (they replace the
+    record's):
+
+    >>> c = NewtonControls(steps=4, tol=1e-10)
+    >>> NewtonControls.of(c, steps=8).steps, c.tol
+    (8, 1e-10)
+
     """
 
     steps: int = 1
@@ -144,6 +154,12 @@ class NewmarkControls(Controls):
     verbose
         Progress and cut steps: ``True``, ``False`` or ``"auto"``
         (:mod:`skfem_pg.progress`).
+
+    Examples
+    --------
+    >>> NewmarkControls().beta, NewmarkControls().gamma  # the trapezoidal rule
+    (0.25, 0.5)
+
     """
 
     beta: float = 0.25
@@ -194,6 +210,12 @@ class ExplicitControls(Controls):
     verbose
         Progress: ``True``, ``False`` or ``"auto"``
         (:mod:`skfem_pg.progress`).
+
+    Examples
+    --------
+    >>> ExplicitControls.of(safety=0.5).safety
+    0.5
+
     """
 
     safety: float = 0.8

@@ -105,7 +105,19 @@ def check_run(n_u, N, m, t_end, dt=None, u0=None, v0=None,
 
 
 class EnergyBalance:
-    """The energies of a run (module docstring), updated per step."""
+    """The energies of a run (module docstring), updated per step.
+
+    Examples
+    --------
+    At rest with nothing stored, the balance starts at zero:
+
+    >>> import numpy as np
+    >>> m, v = np.ones(4), np.zeros(4)
+    >>> eb = EnergyBalance(m, v, np.ones(4, dtype=bool), 0.0)
+    >>> eb.record(0.0, v, np.ones(4, dtype=bool))["relative_error"]
+    0.0
+
+    """
 
     def __init__(self, m, v0, free, stored0=None, dot=None):
         self.m = m
@@ -218,7 +230,22 @@ class Trajectory:
     """A time integration's result: the unknowns ``x`` (displacements
     first), velocities ``v`` and accelerations ``a`` at the final time
     ``t``; ``history``: the energies (:class:`EnergyBalance`) and step
-    data per output; ``steps``; ``times``: wall seconds by part."""
+    data per output; ``steps``; ``times``: wall seconds by part.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem, skfem_pg as pg
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> from skfem_pg.formulations import Hyperelastic
+    >>> from skfem_pg.materials import NeoHooke
+    >>> problem = pg.Problem(Hyperelastic(basis, NeoHooke(60.0, 40.0)),
+    ...                      mass=pg.lumped_mass(basis, 1.0))
+    >>> v0 = np.tile([0.1, 0.0], basis.N // 2)  # a rigid translation
+    >>> tr = pg.central_difference(problem, t_end=0.01, v0=v0, verbose=False)
+    >>> bool(np.allclose(tr.x[0::2], 0.001)), tr.t
+    (True, 0.01)
+
+    """
     x: np.ndarray
     v: np.ndarray
     a: np.ndarray

@@ -65,6 +65,20 @@ class Problem:
 
     The vectors are kept as given: a driver checks their sizes against
     the model (an MPI driver against the serial numbering).
+
+    Examples
+    --------
+    >>> import skfem as fem, skfem_pg as pg
+    >>> from skfem_pg.formulations import Hyperelastic
+    >>> from skfem_pg.materials import NeoHooke
+    >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
+    >>> problem = Problem(Hyperelastic(basis, NeoHooke(60.0, 40.0)),
+    ...                   D=basis.get_dofs(lambda x: x[0] == 0),
+    ...                   walls=pg.solvers.RigidWall(1))
+    >>> len(problem.walls), problem.replace(mass=pg.lumped_mass(
+    ...     basis, 1.0)).mass.shape
+    (1, (50,))
+
     """
 
     model: Any
@@ -127,7 +141,16 @@ class Problem:
 class Solution(NamedTuple):
     """What :func:`~skfem_pg.solvers.newton` returns: ``x``, all unknowns
     (the displacements are ``x[:model.n_u]``), and ``history``, a dict
-    per converged load step.  Unpacks as ``x, history = ...``."""
+    per converged load step.  Unpacks as ``x, history = ...``.
+
+    Examples
+    --------
+    >>> sol = Solution(x=[0.0, 1.0], history=[{"load": 1.0}])
+    >>> x, history = sol
+    >>> sol.history[-1]["load"]
+    1.0
+
+    """
 
     x: np.ndarray
     history: list

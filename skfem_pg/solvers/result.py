@@ -19,7 +19,21 @@ class Result:
     ``ep``, the accumulated plastic strain, per family or cell for a
     plastic material);
     ``x``: all unknowns of ``model`` (``u`` first); ``f_ext``: the external
-    forces at the end of the load path."""
+    forces at the end of the load path.
+
+    Examples
+    --------
+    >>> import numpy as np, skfem as fem
+    >>> from skfem_pg import Scene
+    >>> from skfem_pg.materials import NeoHooke
+    >>> mesh = fem.MeshQuad().refined(2).with_boundaries(
+    ...     {"left": lambda x: x[0] == 0, "right": lambda x: x[0] == 1})
+    >>> res = Scene("block", mesh, NeoHooke(60.0, 40.0), clamped=["left"],
+    ...             tractions={"right": [1.0, 0.0]}).solve("PG", verbose=False)
+    >>> res.u.shape == (res.basis.N,), res.history[-1]["load"]
+    (True, 1.0)
+
+    """
     method: str
     u: np.ndarray
     basis: object
