@@ -55,9 +55,6 @@ METHODS = ("PBG", "PPG1", "PPG2")
 #: (:func:`~skfem_pg.discretization.vc.first_order.correction_functions`)
 VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
                "PPG": ("V1", "V2", "V3", "V4", "VC2")}
-#: family rules with no parameters that may be named
-#: (:data:`skfem_pg.discretization.families.RULES`)
-FAMILY_RULES = ("mesh", "nearest", "horizon")
 BOUNDARIES = ("min-norm", "p", "s", "sn")
 #: keyword of :class:`~skfem_pg.FamilyBasis` -> (the part, its field)
 FIELDS = {"shape": ("shape", "name"),
@@ -493,7 +490,7 @@ def min_members(parts, dim):
     return max(p.min_members(dim) for p in parts)
 
 
-__all__ = ["BOUNDARIES", "CAPABILITIES", "Correction", "FAMILY_RULES",
-           "FamilyRule", "FIELDS", "METHODS", "Method", "NotBuilt", "Part",
-           "Parts", "Quadrature", "Shape", "VC_VARIANTS",
+__all__ = ["BOUNDARIES", "CAPABILITIES", "Correction", "FamilyRule",
+           "FIELDS", "METHODS", "Method", "NotBuilt", "Part", "Parts",
+           "Quadrature", "Shape", "VC_VARIANTS",
            "check", "conflict", "min_members", "refusal", "require"]
