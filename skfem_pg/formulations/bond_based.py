@@ -118,6 +118,46 @@ def segment_cut(a, b):
     return cut
 
 
+def _horizon(p, horizon, absolute):
+    """The horizon length of the particles ``p``: ``horizon`` itself
+    (``absolute``) or times the median particle spacing, checked."""
+    spacing = float(np.median(p.volumes ** (1.0 / p.dim)))
+    try:
+        delta = float(horizon) * (1.0 if absolute else spacing)
+    except (TypeError, ValueError):
+        raise ValueError("BondBased: the horizon must be a number, got "
+                         "{!r}".format(horizon)) from None
+    if not (np.isfinite(delta) and delta > 0):
+        raise ValueError("BondBased: the horizon must be a positive "
+                         "finite {}, got {!r}".format(
+                             "length" if absolute else
+                             "multiple of the particle spacing", horizon))
+    size = float(np.linalg.norm(np.ptp(p.x, axis=1)))
+    if delta >= size:
+        raise ValueError(
+            "BondBased: the horizon {:g} spans the whole body (its "
+            "diameter is {:g}): every particle bonds with every other "
+            "and the micromodulus (~1/horizon^{}) vanishes; give a "
+            "horizon of a few particle spacings (the spacing is {:g}; "
+            "the default is 3 spacings)".format(delta, size, p.dim + 1,
+                                                spacing))
+    return delta
+
+
+def _micromodulus(key, E, nu, delta, G0):
+    """``(c, s0)``: the PMB micromodulus and critical stretch (``None``
+    without a fracture energy ``G0``) in 3-D, plane strain or stress."""
+    if key == "3d":
+        K = E / (3 * (1 - 2 * nu))
+        return 18 * K / (np.pi * delta ** 4), None if G0 is None else \
+            np.sqrt(5 * G0 / (9 * K * delta))
+    if key == "strain":
+        return 48 * E / (5 * np.pi * delta ** 3), None if G0 is None else \
+            np.sqrt(5 * np.pi * G0 / (12 * E * delta))
+    return 9 * E / (np.pi * delta ** 3), None if G0 is None else \
+        np.sqrt(4 * np.pi * G0 / (9 * E * delta))
+
+
 class BondBased:
     r"""The PMB bond-based model (module docstring) on the particles of a
     :class:`~skfem_pg.FamilyBasis` (its dof numbering, volumes and
@@ -187,44 +227,13 @@ class BondBased:
                 "collocate from the part itself (mesh.restrict(elements))"
                 .format(len(empty), p.n, empty[0],
                         np.round(p.x[:, empty[0]], 12).tolist()))
-        spacing = float(np.median(p.volumes ** (1.0 / p.dim)))
-        try:
-            delta = float(horizon) * (1.0 if absolute else spacing)
-        except (TypeError, ValueError):
-            raise ValueError("BondBased: the horizon must be a number, got "
-                             "{!r}".format(horizon)) from None
-        if not (np.isfinite(delta) and delta > 0):
-            raise ValueError("BondBased: the horizon must be a positive "
-                             "finite {}, got {!r}".format(
-                                 "length" if absolute else
-                                 "multiple of the particle spacing",
-                                 horizon))
-        size = float(np.linalg.norm(np.ptp(p.x, axis=1)))
-        if delta >= size:
-            raise ValueError(
-                "BondBased: the horizon {:g} spans the whole body (its "
-                "diameter is {:g}): every particle bonds with every other "
-                "and the micromodulus (~1/horizon^{}) vanishes; give a "
-                "horizon of a few particle spacings (the spacing is {:g}; "
-                "the default is 3 spacings)".format(delta, size, p.dim + 1,
-                                                    spacing))
+        delta = _horizon(p, horizon, absolute)
         self.horizon = delta
         self.E, self.G0 = E, None if G0 is None else float(G0)
         if self.G0 is not None and not self.G0 > 0:
             raise ValueError("BondBased: the fracture energy G0 must be "
                              "positive, got {}".format(G0))
-        if key == "3d":
-            K = E / (3 * (1 - 2 * self.nu))
-            self.c = 18 * K / (np.pi * delta ** 4)
-            s0 = None if G0 is None else np.sqrt(5 * self.G0 / (9 * K * delta))
-        elif key == "strain":
-            self.c = 48 * E / (5 * np.pi * delta ** 3)
-            s0 = None if G0 is None else np.sqrt(
-                5 * np.pi * self.G0 / (12 * E * delta))
-        else:
-            self.c = 9 * E / (np.pi * delta ** 3)
-            s0 = None if G0 is None else np.sqrt(
-                4 * np.pi * self.G0 / (9 * E * delta))
+        self.c, s0 = _micromodulus(key, E, self.nu, delta, self.G0)
         self.s0 = np.inf if s0 is None else float(s0)
         self.x0 = p.x
         self.bonds = bonds_within(p.x, delta)

@@ -438,50 +438,14 @@ class Response:
         self.J = J
         Cp_new = Cpn.copy()  # elastic points keep C_p,n^-1
         if p.size:
-            beta, Q = np.linalg.eigh(btr[p])
-            xtr = np.log(beta)
-            x, da, Jl, tau, T = m.return_map(xtr, alpha_n[p])
-            alpha[p] += da
-            # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
-            dtdx = T @ np.linalg.inv(Jl)[:, :3, :3]
-            self._plastic_spectral = (beta, Q, x, tau, dtdx)
-            QT = np.swapaxes(Q, 1, 2)
-            tau_full[p] = (Q * tau[:, None, :]) @ QT
-            ex = np.exp(x)
-            self._trbb[p] = (ex / np.cbrt(ex.prod(axis=1))[:, None]).sum(
-                axis=1)
-            Fp = Finv[p] @ Q
-            Cp_p = (Fp * ex[:, None, :]) @ np.swapaxes(Fp, 1, 2)
-            Cp_new[p] = 0.5 * (Cp_p + np.swapaxes(Cp_p, 1, 2))
+            alpha[p] += self._return(btr, alpha_n, p, tau_full, Cp_new)
         self.plastic = plastic.reshape(self.point_shape)
         vol = 0.5 * m.K * (J ** 2 - 1) if m.K > 0 else np.zeros(n)
         failed = np.zeros(n, dtype=bool)
         if m.damage is not None:
-            mean = vol if mean_stress is None else np.broadcast_to(
-                np.asarray(mean_stress, dtype=float).reshape(-1), (n,))
-            if p.size:
-                damage[p] += m.damage.increment(alpha[p] - alpha_n[p],
-                                                triaxiality(tau_full[p],
-                                                            mean[p]))
-            strain_law = getattr(m.damage, "indicator", None)
-            if strain_law is not None:  # a criterion on the elastic strain
-                damage = np.maximum(damage, strain_law(btr))
-            failed = damage >= m.damage.Dc
-            # the energy density a point failing now releases: what it
-            # would store intact, less what it keeps (pressure in
-            # compression)
-            released = history["released"].reshape(n).copy()
-            now = failed & (history["damage"].reshape(n) < m.damage.Dc)
-            if now.any():
-                Jn = J[now]
-                released[now] += 0.5 * m.mu * (self._trbb[now] - 3) + \
-                    np.where(Jn >= 1, 0.25 * m.K * (Jn ** 2 - 1
-                                                    - 2 * np.log(Jn)), 0.0)
-            # a failed point: no deviatoric stress, pressure only in
-            # compression (module docstring of skfem_pg.materials.damage)
-            tau_full[failed] = 0.0
-            self._trbb[failed] = 3.0
-            vol = np.where(failed & (J >= 1), 0.0, vol)
+            damage, released, failed, vol = self._damage(
+                history, damage, (alpha, alpha_n), p, tau_full, vol,
+                mean_stress, btr)
         self._failed = failed
         self.failed = failed.reshape(self.point_shape)
         for i in range(3):
@@ -500,6 +464,63 @@ class Response:
             self.history["released"] = released.reshape(self.point_shape)
         self._A = None
         self._spectral = None
+
+    def _return(self, btr, alpha_n, p, tau_full, Cp_new):
+        r"""The return map at the plastic points ``p``: their stress and
+        :math:`C_p^{-1}` (in place in ``tau_full``, ``Cp_new``,
+        ``_trbb``) and the increments of :math:`\alpha` there."""
+        beta, Q = np.linalg.eigh(btr[p])
+        xtr = np.log(beta)
+        x, da, Jl, tau, T = self.material.return_map(xtr, alpha_n[p])
+        # d(x, dalpha)/d xtr = Jl^-1 [I; 0]
+        dtdx = T @ np.linalg.inv(Jl)[:, :3, :3]
+        self._plastic_spectral = (beta, Q, x, tau, dtdx)
+        QT = np.swapaxes(Q, 1, 2)
+        tau_full[p] = (Q * tau[:, None, :]) @ QT
+        ex = np.exp(x)
+        self._trbb[p] = (ex / np.cbrt(ex.prod(axis=1))[:, None]).sum(
+            axis=1)
+        Fp = self._Finv[p] @ Q
+        Cp_p = (Fp * ex[:, None, :]) @ np.swapaxes(Fp, 1, 2)
+        Cp_new[p] = 0.5 * (Cp_p + np.swapaxes(Cp_p, 1, 2))
+        return da
+
+    def _damage(self, history, damage, alphas, p, tau_full, vol,
+                mean_stress, btr):
+        """``(damage, released, failed, vol)``: the damage law's step at
+        the points (thesis 8.1), the energy density released by the
+        points failing now, and a failed point's stress (no deviatoric
+        part, pressure only in compression; in place in ``tau_full`` and
+        ``_trbb``)."""
+        m, J = self.material, self.J
+        alpha, alpha_n = alphas
+        n = J.shape[0]
+        mean = vol if mean_stress is None else np.broadcast_to(
+            np.asarray(mean_stress, dtype=float).reshape(-1), (n,))
+        if p.size:
+            damage[p] += m.damage.increment(alpha[p] - alpha_n[p],
+                                            triaxiality(tau_full[p],
+                                                        mean[p]))
+        strain_law = getattr(m.damage, "indicator", None)
+        if strain_law is not None:  # a criterion on the elastic strain
+            damage = np.maximum(damage, strain_law(btr))
+        failed = damage >= m.damage.Dc
+        # the energy density a point failing now releases: what it
+        # would store intact, less what it keeps (pressure in
+        # compression)
+        released = history["released"].reshape(n).copy()
+        now = failed & (history["damage"].reshape(n) < m.damage.Dc)
+        if now.any():
+            Jn = J[now]
+            released[now] += 0.5 * m.mu * (self._trbb[now] - 3) + \
+                np.where(Jn >= 1, 0.25 * m.K * (Jn ** 2 - 1
+                                                - 2 * np.log(Jn)), 0.0)
+        # a failed point: no deviatoric stress, pressure only in
+        # compression (module docstring of skfem_pg.materials.damage)
+        tau_full[failed] = 0.0
+        self._trbb[failed] = 3.0
+        return damage, released, failed, np.where(failed & (J >= 1), 0.0,
+                                                  vol)
 
     def spectral(self):
         """``(beta, Q, tau, dtau/dxtr)`` at every point: eigenvalues and

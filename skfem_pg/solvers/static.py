@@ -553,6 +553,29 @@ class KeptTangent:
         self.K = self.factor = None
 
 
+def _iterate(algebra, u, lam, info):
+    r"""``(fail, state, r, rn, f_int)`` of the iterate ``u`` at load factor
+    ``lam``: ``fail`` names why it cannot be used (a return map that
+    cannot return, :math:`J \le 0`, a non-finite residual), else
+    ``None``; ``info`` gets the minimum J and the seconds."""
+    t0 = time.perf_counter()
+    fail, state, r, rn, f_int = None, None, None, np.nan, None
+    try:
+        state = algebra.state(u)
+    except ReturnMapError as err:  # a plastic point that cannot return
+        fail = "return map: {}".format(err)
+    if fail is None:
+        info["min_J"] = algebra.min_J(state)
+        if not info["min_J"] > 0:
+            fail = "J <= 0"
+    if fail is None:
+        r, rn, f_int = algebra.residual(state, lam)
+        if not np.isfinite(rn):
+            fail = "non-finite residual"
+    info["t_assemble"] += time.perf_counter() - t0
+    return fail, state, r, rn, f_int
+
+
 def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
                       line_search=False):
     r"""Newton iterations at load factor ``lam`` from the converged ``u``
@@ -592,21 +615,7 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
     fresh = False  # the last increment came from a fresh kept tangent
     it = 0
     while True:
-        t0 = time.perf_counter()
-        fail, rn = None, np.nan
-        try:
-            state = algebra.state(u)
-        except ReturnMapError as err:  # a plastic point that cannot return
-            fail = "return map: {}".format(err)
-        if fail is None:
-            info["min_J"] = algebra.min_J(state)
-            if not info["min_J"] > 0:
-                fail = "J <= 0"
-        if fail is None:
-            r, rn, f_int = algebra.residual(state, lam)
-            if not np.isfinite(rn):
-                fail = "non-finite residual"
-        info["t_assemble"] += time.perf_counter() - t0
+        fail, state, r, rn, f_int = _iterate(algebra, u, lam, info)
         redo = False
         if undo is not None:  # the increment came from kept factors
             if fail is not None or not rn <= REUSE_CONTRACTION * res[-1]:

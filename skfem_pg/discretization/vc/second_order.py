@@ -154,6 +154,27 @@ def _blocks_to_csr(M, fam, d):
                          shape=((d + 1) * fam.n_particles, (d + 1) * nf))
 
 
+def _corrected(G, alpha, phi, fam, x, h, method):
+    """The derivatives ``G`` plus the VC2 correction of the unknowns
+    ``alpha`` ``(nf, d + 1, d)``: PBG's at every member, PPG1's at the
+    masters (functions of the test member)."""
+    mem, mask = fam.padded()
+    if method == "PBG":
+        P = (x / h).T[mem]
+        dX = (P - P[:, :1]) * mask[..., None]  # (k, j, c) scaled
+        # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
+        corr = alpha[:, None, 0, :] + np.einsum("kjc,kcB->kjB", dX,
+                                                alpha[:, 1:, :])
+        return G + phi[:, None, :, None] * (corr * mask[..., None])[
+            :, :, None, :]
+    psi = ppg1_second_order_functions(phi, fam, x, h)
+    Gc = G.copy()
+    Gc[:, 0] += (phi[..., None] * alpha[:, None, 0, :]
+                 + np.einsum("kie,keB->kiB", psi, alpha[:, 1:, :])) \
+        * mask[..., None]
+    return Gc
+
+
 def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
                    boundary="min-norm", method="PBG"):
     """Second-order VC correction of the PBG derivatives ``G`` of
@@ -179,7 +200,6 @@ def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
                          "boundary 's' releases all surface constraints")
     t0 = time.perf_counter()
     d, n = x.shape
-    mem, mask = fam.padded()
     active = volumes > 0
     h = np.mean(volumes[active]) ** (1.0 / d)
     r1, r2 = vc2_residuals(G, dx, fam, x, volumes, area, area2)
@@ -216,20 +236,7 @@ def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
                            conlim=1e12, iter_lim=maxiter or 50 * A.shape[1])
             alpha[:, :, b] = sol[0].reshape(-1, d + 1)
             its = max(its, sol[2])
-    if method == "PBG":
-        P = (x / h).T[mem]
-        dX = (P - P[:, :1]) * mask[..., None]  # (k, j, c) scaled
-        # correction c[k, j, B] = α[k, 0, B] + Σ_c β[k, c, B] ΔX[k, j, c]
-        corr = alpha[:, None, 0, :] + np.einsum("kjc,kcB->kjB", dX,
-                                                alpha[:, 1:, :])
-        Gc = G + phi[:, None, :, None] * (corr * mask[..., None])[:, :, None,
-                                                                  :]
-    else:  # PPG1: at the masters, functions of the test member i
-        psi = ppg1_second_order_functions(phi, fam, x, h)
-        Gc = G.copy()
-        Gc[:, 0] += (phi[..., None] * alpha[:, None, 0, :]
-                     + np.einsum("kie,keB->kiB", psi, alpha[:, 1:, :])) \
-            * mask[..., None]
+    Gc = _corrected(G, alpha, phi, fam, x, h, method)
     s1, s2 = vc2_residuals(Gc, dx, fam, x, volumes, area, area2)
     scale = h ** (d - 1)
     before = max(np.abs(r1[keep]).max(), np.abs(r2[keep]).max() / h)
