@@ -233,18 +233,9 @@ def _options(name, text):
 def _checked(name, kw, frame):
     """``kw``, after the parts of :mod:`skfem_pg.discretization.parts`
     have said that they work together (and in the UL frame)."""
-    try:
-        ps = parts.Parts(
-            shape=parts.Shape(kw["shape"], kw.get("weight_exponent", 1.0)),
-            quadrature=parts.Quadrature(
-                kw.get("weights", "uniform"),
-                kw.get("family_quadrature", "members")),
-            correction=parts.Correction(
-                kw["bond"], kw["vc"], kw.get("vc_boundary", "min-norm"),
-                kw.get("vc_solver", "auto"),
-                kw.get("vc_exclude") or None),
-            method=parts.Method(kw["method"], kw.get("test_shape", "master"),
-                                kw.get("lme_mu", 1.8)))
+    try:  # families are not parts of this check (they may be 'given')
+        ps = parts.from_keywords({k: v for k, v in kw.items()
+                                  if k != "families"})
         parts.check(ps)
         if frame == "UL":
             parts.require("updated_lagrangian", ps)

@@ -261,15 +261,14 @@ class BasisSpec:
             weights = "volume"
         if not isinstance(rule, parts_mod.FamilyRule):
             rule = parts_mod.FamilyRule(rule)
-        return cls(parts_mod.Parts(
-            family_rule=rule,
-            shape=parts_mod.Shape(shape, recipes.check_exponent(
-                weight_exponent)),
-            quadrature=parts_mod.Quadrature(weights, family_quadrature),
-            correction=parts_mod.Correction(
-                bool(bond), vc, vc_boundary, vc_solver, vc_exclude,
-                vc_tolerance),
-            method=method), dim)
+        return cls(parts_mod.from_keywords(dict(
+            shape=shape,
+            weight_exponent=recipes.check_exponent(weight_exponent),
+            weights=weights, family_quadrature=family_quadrature,
+            bond=bool(bond), vc=vc, vc_boundary=vc_boundary,
+            vc_solver=vc_solver, vc_exclude=vc_exclude,
+            vc_tolerance=vc_tolerance, method=method.name,
+            test_shape=test_shape, lme_mu=lme_mu), rule), dim)
 
 
 def _default_rule(particles, shape, family_quadrature):
@@ -581,12 +580,6 @@ def _grouped(particles, fam, spec, area_vectors, vc_solve, timings):
                        vc_report=report, timings=timings)
 
 
-def distributed_supports(spec):
-    """Whether a partition can build ``spec`` (its parts support
-    ``"mpi"``, :mod:`~skfem_pg.discretization.parts`)."""
-    return spec.supports("mpi")
-
-
 def build(particles, spec, area_vectors=None, distributed=None):
     """Run the stages of ``spec`` on ``particles``; ``distributed`` (a
     :class:`~skfem_pg.distributed.Partition`) supplies the VC solve of all
@@ -615,5 +608,5 @@ def build(particles, spec, area_vectors=None, distributed=None):
 
 __all__ = ["BasisArrays", "BasisSpec", "CORRECTIONS", "METHODS", "surface_of",
            "TEST_GRADIENTS", "VC_VARIANTS", "area_vectors_of", "build",
-           "check_family_sizes", "distributed_supports", "make_families",
+           "check_family_sizes", "make_families",
            "trial_gradients"]

@@ -37,6 +37,7 @@ from typing import Optional
 import numpy as np
 
 from ..errors import FamilyError
+from .vc.boundary import BOUNDARY_VARIANTS
 
 #: what a basis may be asked to do, and who asks
 CAPABILITIES = {
@@ -55,7 +56,8 @@ METHODS = ("PBG", "PPG1", "PPG2")
 #: (:func:`~skfem_pg.discretization.vc.first_order.correction_functions`)
 VC_VARIANTS = {"PBG": ("V2", "V3", "V4", "V5", "VC2"),
                "PPG": ("V1", "V2", "V3", "V4", "VC2")}
-BOUNDARIES = ("min-norm", "p", "s", "sn")
+#: the VC system's boundary variants (:mod:`~skfem_pg.discretization.vc.boundary`)
+BOUNDARIES = BOUNDARY_VARIANTS
 #: keyword of :class:`~skfem_pg.FamilyBasis` -> (the part, its field)
 FIELDS = {"shape": ("shape", "name"),
           "weight_exponent": ("shape", "weight_exponent"),
@@ -150,13 +152,8 @@ class FamilyRule(Part):
         """The families on ``particles``."""
         if self.given:
             return self.rule
-        from .families import RULES, from_mesh, horizon
-        if not self.parameters:
-            from .families import build
-            return build(self.rule, particles)
-        rule = {"mesh": from_mesh, "horizon": horizon}.get(self.rule,
-                                                            RULES[self.rule])
-        return rule(particles, **dict(self.parameters))
+        from .families import RULES  # checked in __post_init__
+        return RULES[self.rule](particles, **dict(self.parameters))
 
     def refusal(self, capability, parts):
         if capability == "mpi" and not self.given and \
@@ -451,6 +448,25 @@ class Parts:
                      self.method, self.family_rule))
 
 
+def from_keywords(keywords, family_rule=None):
+    """The :class:`Parts` of :class:`~skfem_pg.FamilyBasis` keywords
+    (:data:`FIELDS`; a part's fields not among them keep its defaults;
+    other keys are ignored) with ``family_rule`` (default the mesh rule).
+
+    >>> from_keywords({"shape": "WTE2", "bond": False}).correction.bond
+    False
+    """
+    fields = {}
+    for key, value in keywords.items():
+        if key in FIELDS:
+            part, field = FIELDS[key]
+            fields.setdefault(part, {})[field] = value
+    return Parts(family_rule=family_rule or FamilyRule("mesh"), **{
+        part: kind(**fields.get(part, {})) for part, kind in (
+            ("shape", Shape), ("quadrature", Quadrature),
+            ("correction", Correction), ("method", Method))})
+
+
 def conflict(parts):
     """The first of the parts' conflicts: ``None``, a string
     (``ValueError``) or :class:`NotBuilt` (``NotImplementedError``)."""
@@ -493,4 +509,4 @@ def min_members(parts, dim):
 __all__ = ["BOUNDARIES", "CAPABILITIES", "Correction", "FamilyRule",
            "FIELDS", "METHODS", "Method", "NotBuilt", "Part", "Parts",
            "Quadrature", "Shape", "VC_VARIANTS",
-           "check", "conflict", "min_members", "refusal", "require"]
+           "check", "conflict", "from_keywords", "min_members", "refusal", "require"]

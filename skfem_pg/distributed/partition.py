@@ -460,11 +460,9 @@ class Partition:
     def sum_particles(self, r):
         """Per-particle arrays of the local particles ``(n_local, ...)``
         summed over all ranks into ``(n, ...)`` on every rank."""
-        from mpi4py import MPI
         out = np.zeros((self.n,) + r.shape[1:])
         out[self.local] = r  # each local particle once
-        self.comm.Allreduce(MPI.IN_PLACE, out, op=MPI.SUM)
-        return out
+        return self.sum_ranks(out)
 
     def vc_correction(self, *args, **kwargs):
         """:func:`skfem_pg.distributed.vc.vc_correction` on this partition

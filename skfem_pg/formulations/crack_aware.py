@@ -87,6 +87,7 @@ import numpy as np
 
 from ..discretization.assembly import assemble
 from ..discretization.basis import FamilyBasis
+from ..discretization import parts
 from ..discretization.cracks import failure_counts, pieces, separate
 from ..discretization.particles import Particles
 from ..errors import FamilyError, describe_particle
@@ -160,8 +161,8 @@ def _check_crack_inputs(basis, material, fraction, what):
         raise ValueError("crack-aware families remove failed cells of "
                          "the collocation mesh: the particles must be "
                          "a mesh's vertices (Particles.from_mesh)")
-    why = None if part is not None else basis.spec.parts.family_rule \
-        .refusal("crack_rebuild", basis.spec.parts)
+    why = None if part is not None else \
+        parts.refusal("crack_rebuild", basis.spec.parts)
     if why is not None:  # a rank's families follow the partition's rule
         raise ValueError(why)
     damage = getattr(material, "damage", None)
