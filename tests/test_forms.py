@@ -10,6 +10,7 @@ from skfem.helpers import (ddot, det, eye, grad, identity, inv, mul,
                            sym_grad, trace, transpose)
 
 import skfem_pg as pg
+from skfem_pg.discretization.basis import form_roles
 
 
 def _stiffness(u, v, w):
@@ -43,9 +44,15 @@ def test_plain_scikit_fem_calls_on_ppg_raise(cantilever):
 
 
 def test_ppg_generic_with_test_basis_equals_fast_path(cantilever):
+    """scikit-fem's generic path with the roles the package's forms vouch
+    for equals the batched path; scikit-fem's forms alone are refused even
+    in the right order (they do not say which basis tests), and so is the
+    package's assemble with the trial basis as test basis."""
     _, b = cantilever
     K = fem.BilinearForm(_stiffness)
-    with pytest.warns(pg.SlowAssemblyWarning):
+    with pytest.raises(ValueError, match="Petrov"):
+        K.assemble(b, b.test)
+    with form_roles(K, b, b.test):
         Kg = K.assemble(b, b.test)
     Kf = pg.assemble(K, b)
     Kd = pg.BilinearForm(_stiffness).assemble(b)
@@ -53,13 +60,37 @@ def test_ppg_generic_with_test_basis_equals_fast_path(cantilever):
     assert abs(Kd - Kf).max() == 0.0
     P = b.interpolate(np.sin(np.arange(b.N))).grad
     f = fem.LinearForm(_internal)
-    fg, ff = f.assemble(b.test, P=P), pg.assemble(f, b, P=P)
+    with pytest.raises(ValueError, match="Petrov"):
+        f.assemble(b.test, P=P)
+    with form_roles(f, b, b.test):
+        fg = f.assemble(b.test, P=P)
+    ff = pg.assemble(f, b, P=P)
     fd = pg.LinearForm(_internal).assemble(b, P=P)
     assert np.abs(fg - ff).max() < 1e-12 * np.abs(ff).max()
     assert np.abs(fd - ff).max() == 0.0
-    # Bubnov–Galerkin with PPG weights is far from it: the case refused
-    Kbg = pg.assemble(K, b, b)
+    for call in (lambda: pg.assemble(K, b, b), lambda: pg.assemble(K, b.test),
+                 lambda: pg.assemble(f, b, b, P=P),
+                 lambda: pg.assemble(fem.Functional(lambda w: w.x[0]), b)):
+        with pytest.raises(ValueError, match="Petrov"):
+            call()
+    # what the refused pairing would give: Bubnov–Galerkin with PPG weights
+    with form_roles(K, b, b.test):
+        Kbg = K.assemble(b, b)
     assert abs(Kbg - Kf).max() > 1e-2 * abs(Kf).max()
+
+
+def test_plain_scikit_fem_forms_on_pbg_warn_slow_once_per_assembly():
+    b = pg.FamilyBasis(fem.MeshTri().refined(2))
+    K = fem.BilinearForm(lambda u, v, w: u * v)
+    for _ in range(2):
+        with pytest.warns(pg.SlowAssemblyWarning) as record:
+            K.assemble(b)
+        assert len(record) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pg.BilinearForm(lambda u, v, w: u * v).assemble(b)
+        area = fem.Functional(lambda w: 1.0 + 0 * w.x[0]).assemble(b)
+    assert area == pytest.approx(1.0, rel=1e-12)
 
 
 def test_ppg_cantilever_through_package_forms():
@@ -73,9 +104,11 @@ def test_ppg_cantilever_through_package_forms():
                     [0.0, 1.0])
     D = b.get_dofs(mesh.facets_satisfying(lambda x: x[0] == 0))
     tips = []
+    K = fem.BilinearForm(_stiffness)
+    with form_roles(K, b, b.test):  # the pairing the package refuses
+        Kbg = K.assemble(b, b)
     for K in (pg.BilinearForm(_stiffness).assemble(b),
-              pg.assemble(fem.BilinearForm(_stiffness), b),
-              pg.assemble(fem.BilinearForm(_stiffness), b, b)):
+              pg.assemble(fem.BilinearForm(_stiffness), b), Kbg):
         tips.append(fem.solve(*fem.condense(K, f, D=D))[1::2].max())
     assert abs(tips[0] - 3.2107) < 1e-3
     assert tips[1] == pytest.approx(tips[0], rel=1e-10)

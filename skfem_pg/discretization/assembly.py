@@ -43,7 +43,7 @@ from skfem.assembly.form.form import FormExtraParams
 from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField, ElementVector
 
-from .basis import FamilyBasis, warn_equal_order_mixed
+from .basis import FamilyBasis, form_roles
 from .shape.common import chunks
 from ..threads import kernel
 
@@ -496,7 +496,6 @@ def assemble_local(basis, local_matrices, view=None, transposed=False):
     (no copy of the local matrices).
     """
     view = batched_view(basis) if view is None else view
-    nc = view.nc
     pieces = block_pattern(basis, view)[2]
     index, indptr, indices = entry_index(basis, view, transposed)
     data = np.zeros(int(indptr[-1]))
@@ -568,11 +567,22 @@ def assemble(form: fem.assembly.form.Form, basis: AbstractBasis,
     """
     local_extra = kwargs.pop("local_extra", None)
     if vbasis is None:
-        test = getattr(basis, "test", None)
-        vbasis = basis if test is None else test
-    elif getattr(vbasis, "families", None) is getattr(basis, "families",
-                                                       False):
-        warn_equal_order_mixed(basis, vbasis)  # else the generic path warns
+        vbasis = test_basis(form, basis)
+    with form_roles(form, basis, vbasis, kwargs):
+        return _assemble(form, basis, vbasis, kwargs, local_extra)
+
+
+def test_basis(form, basis):
+    """The basis a form tests with when none is given: ``basis.test`` of
+    a Petrov–Galerkin family basis (bilinear and linear forms: PPG
+    internal forces), else ``basis`` itself."""
+    test = getattr(basis, "test", None)
+    if test is None or isinstance(form, fem.Functional):
+        return basis
+    return test
+
+
+def _assemble(form, basis, vbasis, kwargs, local_extra):
     view = batched_view(basis)
     if vbasis is basis:
         vview = view
@@ -593,7 +603,7 @@ def assemble(form: fem.assembly.form.Form, basis: AbstractBasis,
                          "tested with itself)")
     if isinstance(form, LinearForm):
         return _generic(form, vbasis, **kwargs)
-    if vbasis is basis:
+    if vbasis is basis or isinstance(form, fem.Functional):
         return _generic(form, basis, **kwargs)
     return _generic(form, basis, vbasis, **kwargs)
 

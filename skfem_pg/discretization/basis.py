@@ -20,9 +20,10 @@ Peridynamic Bubnov–Galerkin (PBG) method:
 Petrov–Galerkin (``method="PPG1"``/``"PPG2"``,
 :mod:`skfem_pg.discretization.petrov`): the same elements with weights
 :math:`V^k` and a separate test basis ``basis.test`` (derivatives at the
-masters, VC-corrected); assemble with
-:func:`skfem_pg.assemble`, which picks ``basis.test`` up, or with
-scikit-fem's ``form.assemble(basis, basis.test)``.
+masters, VC-corrected); assemble with the package's forms
+(:class:`skfem_pg.BilinearForm`, :func:`skfem_pg.assemble`), which pick
+``basis.test`` up.  scikit-fem's own forms refuse a Petrov–Galerkin basis:
+they do not say which role a basis plays (:func:`form_roles`).
 
 Degrees of freedom follow scikit-fem's nodal numbering of the mesh the
 particles were collocated from (vector dof ``c`` of particle ``p`` is
@@ -35,9 +36,10 @@ assembly; the batched hot paths (:func:`skfem_pg.assemble`,
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import copy
 import inspect
-import sys
 import warnings
 
 import numpy as np
@@ -320,6 +322,8 @@ class FamilyBasis(AbstractBasis):
 
     """
 
+    _generic_pending = False  # a scikit-fem form asked for parameters
+
     def __new__(cls, particles=None, *args, order: int = 1, **kwargs):
         # order=2: the blended quadratic basis, another kind of element
         # (a mesh cell over its vertices' families); __init__ is skipped
@@ -502,7 +506,20 @@ class FamilyBasis(AbstractBasis):
     @property
     def basis(self):
         """Basis functions at the members, built on first use (only the
-        generic scikit-fem assembly path needs them)."""
+        generic scikit-fem assembly path needs them).  A scikit-fem form
+        that reads them warns once per assembly
+        (:class:`~skfem_pg.errors.SlowAssemblyWarning`)."""
+        if self._generic_pending:
+            self._generic_pending = False
+            warnings.warn(
+                "scikit-fem's generic assembly on a FamilyBasis calls the "
+                "form once per local basis function ({}) or, bilinear, per "
+                "pair of them ({} calls) and is 5-40x slower than "
+                "skfem_pg.assemble; use skfem_pg.BilinearForm / LinearForm "
+                "as decorators (same forms, fast path) or "
+                "skfem_pg.assemble(form, basis)".format(
+                    self.Nbfun, self.Nbfun ** 2), SlowAssemblyWarning,
+                stacklevel=2)
         if self._basis is None:
             self._basis = [self._basis_function(ix)
                            for ix in range(self.Nbfun)]
@@ -627,8 +644,16 @@ class FamilyBasis(AbstractBasis):
                 "basis.test.interpolate(u))")
         w = np.asarray(w)
         if w.shape[0] != self.N:
-            raise ValueError("Input array has wrong size: {} != N = {}"
-                             .format(w.shape[0], self.N))
+            cells = (self.mesh is not None
+                     and w.shape[0] == self.mesh.nelements)
+            raise ValueError(
+                "Input array has wrong size: {} != N = {}{}".format(
+                    w.shape[0], self.N,
+                    " (one value per cell?  a FamilyBasis integrates at "
+                    "its family members: evaluate a cell field there with "
+                    "skfem_pg.discretization.coefficients."
+                    "cell_values_at_members(basis, values))" if cells
+                    else ""))
         L = self.layout
         nc = 1 if self.ncomp is None else self.ncomp
         d = self.particles.dim
@@ -827,8 +852,23 @@ class FamilyBasis(AbstractBasis):
         return DiscreteField(np.broadcast_to(h[:, None], mem.shape).copy())
 
     def default_parameters(self):
-        """``w.x`` (member positions) and ``w.h`` (family radius)."""
-        _check_generic_assembly(self, sys._getframe(1))
+        """``w.x`` (member positions) and ``w.h`` (family radius).
+
+        Outside the package's forms (:func:`form_roles`) a Petrov–Galerkin
+        basis refuses: scikit-fem's forms do not say whether it is asked as
+        the trial or the test basis.
+        """
+        if _ROLES.get() is None:
+            if self.is_petrov:
+                raise ValueError(
+                    "scikit-fem's own forms on a Petrov–Galerkin FamilyBasis "
+                    "cannot say whether this basis is asked for trial or "
+                    "test functions, and the wrong pairing is silently "
+                    "wrong (a Bubnov–Galerkin matrix with PPG weights, "
+                    "8.3x too stiff on a cantilever); {}; a Functional "
+                    "needs a PBG basis of the same particles".format(
+                        _PPG_HOWTO))
+            self._generic_pending = True  # see the basis property
         return {"x": self.global_coordinates(),
                 "h": self.mesh_parameters()}
 
@@ -877,12 +917,9 @@ class FamilyBasis(AbstractBasis):
     __str__ = __repr__
 
 
-_PPG_HOWTO = ("assemble it with skfem_pg.assemble(form, basis) (it takes "
-              "basis.test), with the package's forms "
-              "(skfem_pg.BilinearForm / LinearForm), or with scikit-fem's "
-              "generic path and the test basis given explicitly: "
-              "bilinear form.assemble(basis, basis.test), linear "
-              "form.assemble(basis.test, ...)")
+_PPG_HOWTO = ("assemble with the package's forms, which test with "
+              "basis.test: skfem_pg.BilinearForm / LinearForm as decorators "
+              "(the same form functions) or skfem_pg.assemble(form, basis)")
 
 
 def _as_particles(particles):
@@ -920,64 +957,94 @@ def warn_equal_order_mixed(ubasis, vbasis):
             MixedBasisWarning, stacklevel=4)
 
 
-def _check_generic_assembly(basis, frame):
-    """Refuse scikit-fem's generic assembly where it would silently build
-    the wrong thing on a Petrov–Galerkin basis, and say that it is slow.
+# Set while the package's own forms assemble (:func:`form_roles`): they
+# pass the trial and the test basis explicitly, so the roles are known.
+_ROLES = contextvars.ContextVar("skfem_pg_form_roles", default=None)
 
-    scikit-fem's ``BilinearForm._assemble(ubasis, vbasis)``,
-    ``LinearForm._assemble`` and ``Functional.elemental`` ask the basis for
-    ``default_parameters()``; ``frame`` is the caller's frame, whose locals
-    tell the roles.  PPG needs trial functions from ``basis`` and test
-    functions from ``basis.test``: ``form.assemble(basis)`` would test with
-    the trial functions (a Bubnov–Galerkin matrix with PPG weights, e.g.
-    8.3× too stiff on a cantilever), and a functional would count every
+
+def check_roles(form, ubasis, vbasis=None, kwargs=None):
+    """Refuse a trial/test pairing that would assemble a wrong matrix or
+    vector on a Petrov–Galerkin basis, name bad coefficients, and warn on
+    an equal-order displacement–pressure pair.
+
+    PPG needs trial functions from ``basis`` and test functions from
+    ``basis.test``: testing with the trial functions gives a
+    Bubnov–Galerkin matrix with PPG weights (8.3× too stiff on a
+    cantilever, ``tests/test_forms.py``), and a functional counts every
     particle once per family it belongs to.
+
+    Parameters
+    ----------
+    form : skfem.assembly.form.Form
+        The form (bilinear, linear or functional).
+    ubasis : AbstractBasis
+        The trial basis (a functional: the basis).
+    vbasis : AbstractBasis, optional
+        The test basis (a linear form: the basis it is assembled on);
+        ``ubasis`` if omitted.
+    kwargs : dict, optional
+        The form's coefficients.
+
+    Examples
+    --------
+    >>> import skfem as fem, skfem_pg as pg
+    >>> b = pg.FamilyBasis(fem.MeshTri().refined(2), method="PPG1")
+    >>> K = fem.BilinearForm(lambda u, v, w: u * v)
+    >>> check_roles(K, b, b.test)   # trial, test: fine
+    >>> check_roles(K, b)
+    Traceback (most recent call last):
+    ...
+    ValueError: BilinearForm '<lambda>' on a Petrov–Galerkin ...
     """
-    form = frame.f_locals.get("self")
-    if not isinstance(form, fem.assembly.form.Form):
-        return
+    vbasis = ubasis if vbasis is None else vbasis
     name = getattr(form.form, "__name__", "form")
+    if isinstance(ubasis, FamilyBasis) and kwargs:
+        # FE quadrature data or another element's dofs: named here, before
+        # scikit-fem's "Quadrature mismatch" / "wrong size"
+        from .assembly import check_coefficients
+        check_coefficients(ubasis, kwargs)
+    if vbasis is not ubasis and isinstance(form, fem.BilinearForm):
+        warn_equal_order_mixed(ubasis, vbasis)
     if isinstance(form, fem.Functional):
-        if basis.is_petrov:
+        if isinstance(ubasis, FamilyBasis) and ubasis.is_petrov:
             raise ValueError(
                 "Functional '{}' on a Petrov–Galerkin FamilyBasis: its "
                 "weights V^j count each particle once per family it belongs "
                 "to, so the integral is wrong; integrate on a PBG basis of "
                 "the same particles (FamilyBasis(..., method='PBG'))"
                 .format(name))
-        return
-    loc = frame.f_locals
-    u, v = loc.get("ubasis", basis), loc.get("vbasis", basis)
-    kwargs = loc.get("kwargs")
-    if isinstance(kwargs, dict) and kwargs:
-        # FE quadrature data or another element's dofs: named here, before
-        # scikit-fem's "Quadrature mismatch" / "wrong size"
-        from .assembly import check_coefficients
-        check_coefficients(basis, kwargs)
-    if v is not u and u is basis:  # once per form, from the trial side
-        warn_equal_order_mixed(u, v)
-    if not isinstance(form, fem.LinearForm):  # bilinear (or trilinear)
-        if isinstance(u, FamilyBasis) and u.trial is not None:
+    elif isinstance(form, fem.LinearForm):
+        if isinstance(vbasis, FamilyBasis) and vbasis.test is not None:
+            raise ValueError(
+                "LinearForm '{}' on the trial basis of a Petrov–Galerkin "
+                "FamilyBasis would test with the trial functions (wrong); "
+                "{}".format(name, _PPG_HOWTO))
+    elif isinstance(ubasis, FamilyBasis):  # bilinear
+        if ubasis.trial is not None:
             raise ValueError(
                 "BilinearForm '{}' got the Petrov–Galerkin test basis as "
                 "its trial basis; {}".format(name, _PPG_HOWTO))
-        if isinstance(u, FamilyBasis) and u.test is not None \
-                and v is not u.test:
+        if ubasis.test is not None and vbasis is not ubasis.test:
             raise ValueError(
                 "BilinearForm '{}' on a Petrov–Galerkin FamilyBasis without "
                 "its test basis would assemble a Bubnov–Galerkin matrix "
                 "with PPG weights (wrong); {}".format(name, _PPG_HOWTO))
-    elif isinstance(v, FamilyBasis) and v.test is not None:
-        raise ValueError(
-            "LinearForm '{}' on the trial basis of a Petrov–Galerkin "
-            "FamilyBasis would test with the trial functions (wrong); {}"
-            .format(name, _PPG_HOWTO))
-    if (isinstance(form, fem.BilinearForm) and u is basis
-            and not getattr(form, "_pg_fast", False)):
-        warnings.warn(
-            "scikit-fem's generic assembly of '{}' on a FamilyBasis calls "
-            "the form once per pair of local basis functions ({} calls) and "
-            "is 5-40x slower than skfem_pg.assemble; use "
-            "skfem_pg.BilinearForm / LinearForm as decorators (same forms, "
-            "fast path) or skfem_pg.assemble(form, basis)".format(
-                name, basis.Nbfun ** 2), SlowAssemblyWarning, stacklevel=5)
+
+
+@contextlib.contextmanager
+def form_roles(form, ubasis, vbasis=None, kwargs=None):
+    """Assemble ``form`` with scikit-fem's generic path inside this block,
+    the roles checked by :func:`check_roles`.
+
+    A family basis' ``default_parameters`` refuses a Petrov–Galerkin basis
+    outside such a block: scikit-fem's forms ask one basis for its
+    parameters and do not say which role it plays, so only the package's
+    forms (:class:`skfem_pg.BilinearForm`, :func:`skfem_pg.assemble`),
+    which pass both bases, can vouch for the pairing.
+    """
+    check_roles(form, ubasis, vbasis, kwargs)
+    token = _ROLES.set((ubasis, vbasis))
+    try:
+        yield
+    finally:
+        _ROLES.reset(token)

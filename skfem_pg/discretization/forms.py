@@ -7,9 +7,10 @@ form functions, same ``assemble`` signature); their ``assemble`` runs
 script that swaps ``Basis`` for ``FamilyBasis`` changes one import line and
 keeps fast-path speed (``tests/test_forms.py``; benchmarks/README.md,
 "Measurements behind the defaults").  On a
-Petrov–Galerkin basis they test with ``basis.test``.  Forms the fast path
-cannot probe (``u.hess``, ...) and other bases (facet, composite, mixed)
-take scikit-fem's generic path.
+Petrov–Galerkin basis they test with ``basis.test`` (scikit-fem's own forms
+refuse such a basis: :func:`~skfem_pg.discretization.basis.form_roles`).
+Forms the fast path cannot probe (``u.hess``, ...) and other bases (facet,
+composite, mixed) take scikit-fem's generic path, the roles checked.
 
 >>> from skfem_pg import BilinearForm
 >>> @BilinearForm
@@ -19,6 +20,7 @@ take scikit-fem's generic path.
 import skfem as fem
 
 from . import assembly
+from .basis import form_roles
 
 
 def _fast(form, base, ubasis, vbasis, kwargs):
@@ -27,8 +29,12 @@ def _fast(form, base, ubasis, vbasis, kwargs):
             return assembly.assemble(form, ubasis, vbasis, **kwargs)
         except assembly.ProbeError:
             pass  # needs more than values and gradients
-    args = (ubasis,) if vbasis is None else (ubasis, vbasis)
-    return base.assemble(form, *args, **kwargs)
+    if vbasis is None:
+        vbasis = assembly.test_basis(form, ubasis)
+    with form_roles(form, ubasis, vbasis, kwargs):
+        if base is fem.LinearForm:
+            return base.assemble(form, vbasis, **kwargs)
+        return base.assemble(form, ubasis, vbasis, **kwargs)
 
 
 class BilinearForm(fem.BilinearForm):
