@@ -16,7 +16,7 @@ assembly) → :mod:`~skfem_pg.formulations` (with :mod:`~skfem_pg.materials`)
 True
 """
 from . import (discretization, formulations, materials, solvers, analysis,
-               scenes, threads, errors, registry)
+               scenes, threads, errors, registry, loadcase)
 from .discretization import (particles, families, shape, corrections,
                              vc, loads)
 from .scenes import meshing, reference
@@ -26,6 +26,7 @@ from .errors import (ParticleError, FamilyError, CorrectionError,
 from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
+from .discretization.follower import FollowerPressure
 from .io import write_vtu
 from .scenes import Scene
 from .solvers import (newton, newmark, central_difference, lumped_mass,
@@ -44,4 +45,5 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "ParticleError", "FamilyError", "CorrectionError",
            "UnsupportedMeshError", "registry", "register_formulation",
            "Scene", "newton", "newmark", "central_difference",
-           "lumped_mass", "NewtonControls", "Problem"]
+           "lumped_mass", "NewtonControls", "Problem", "loadcase",
+           "FollowerPressure"]

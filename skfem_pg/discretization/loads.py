@@ -241,13 +241,23 @@ def _area_correction(basis, facets):
 
 def body_force(basis: AbstractBasis, b: ArrayLike | Callable,
                rho: float | ArrayLike = 1.0) -> np.ndarray:
-    r"""Nodal forces :math:`\rho_0 b(X^i) V^i` of a body force ``b``
-    (constant vector or callable of positions ``(dim, n)``)."""
+    r"""Nodal forces of a body force ``b`` (a constant vector or a
+    callable of reference positions ``(dim, ...)``) per unit mass, density
+    ``rho``: :math:`\rho_0 b(X^i) V^i` on particles, the consistent
+    :math:`\int \rho_0\, b \cdot v\, dV` on a scikit-fem basis (a
+    callable ``rho`` there is evaluated at the quadrature points).
+
+    >>> import skfem as fem, skfem_pg as pg
+    >>> mesh = fem.MeshTri().refined(2)
+    >>> fe = fem.Basis(mesh, fem.ElementVector(fem.ElementTriP1()))
+    >>> for basis in (pg.FamilyBasis(mesh, dim=2), fe):
+    ...     f = body_force(basis, [0.0, -9.81], rho=2.0)
+    ...     print(round(float(f[1::2].sum()), 12))
+    -19.62
+    -19.62
+    """
     if not is_family_basis(basis):
-        raise TypeError(
-            "body_force lumps b V^i on particles; for a scikit-fem basis "
-            "assemble the consistent load instead, e.g. "
-            "LinearForm(lambda v, w: dot(b, v)).assemble(basis)")
+        return _consistent_body_force(basis, b, rho)
     x, V = basis.particles.x, basis.particles.volumes
     n = len(V)
     nc = 1 if basis.ncomp is None else basis.ncomp
@@ -270,6 +280,31 @@ def body_force(basis: AbstractBasis, b: ArrayLike | Callable,
         return rho * np.broadcast_to(bv.reshape(-1), V.shape) * V
     bv = np.broadcast_to(bv.reshape(nc, -1), (nc, n))
     return (rho * bv * V).T.ravel()
+
+
+def _consistent_body_force(basis, b, rho):
+    r""":math:`\int \rho\, b \cdot v\, dV` on a scikit-fem vector (or
+    scalar) basis."""
+    nc = len(basis.split_indices()) if hasattr(basis, "split_indices") \
+        else 1
+
+    @fem.LinearForm
+    def load(v, w):
+        x = w.x
+        bv = call_user(b, x, "the body force b(x)") if callable(b) \
+            else np.asarray(b, dtype=float)
+        r = call_user(rho, x, "the density rho(x)") if callable(rho) \
+            else rho
+        if nc == 1:
+            return r * bv * v
+        bv = np.asarray(bv, dtype=float)
+        if bv.shape[0] != nc:
+            raise ValueError("body force b must have {} components, got "
+                             "shape {}".format(nc, bv.shape))
+        bv = bv.reshape((nc,) + (1,) * (v.ndim - 1)) if bv.ndim == 1 \
+            else bv
+        return r * sum(bv[c] * v[c] for c in range(nc))
+    return load.assemble(basis)
 
 
 def _constant(t, basis, what):

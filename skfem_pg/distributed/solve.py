@@ -26,6 +26,7 @@ from ..solvers.result import Result
 from ..progress import Echo
 from ..solvers.controls import NewtonControls
 from ..solvers.problem import Problem, Solution
+from ..discretization.follower import split_loads
 from ..solvers.static import (LinearSolveFailed, load_stepping,
                               newton_iterations)
 
@@ -157,6 +158,10 @@ def newton(model, part, f_ext=None, D=None, u_D=None, options=None,
         raise ValueError("the model is not on this partition's local "
                          "basis ({} dofs, the partition has {} local dofs)"
                          .format(model.N, len(part.local) * part.ncomp))
+    if split_loads(f_ext)[1]:
+        raise NotImplementedError(
+            "follower loads (FollowerPressure) on MPI ranks: the "
+            "distributed Newton takes dead load vectors; run it serially")
     F = pt.from_serial(np.zeros(part.N) if f_ext is None else f_ext, part)
     if callable(u_D):
         rows = _dirichlet(part, D, None)[0]
@@ -236,7 +241,7 @@ class PetscAlgebra:
         return self.part.comm.allreduce(self.model.min_J(state),
                                         op=mpi().MIN)
 
-    def residual(self, state, lam):
+    def residual(self, state, lam, u=None):
         """``R = λ f_ext - f_int`` with zeros at the Dirichlet rows, its
         norm, and ``None`` (the internal force stays distributed)."""
         R = pt.vector(-self.model.internal_force(state), self.part)
@@ -249,7 +254,7 @@ class PetscAlgebra:
     def load_norm(self, lam):
         return lam * self.F.norm()
 
-    def solve(self, state, u, R, du_D, first):
+    def solve(self, state, u, R, du_D, first, lam=1.0):
         t0 = time.perf_counter()
         K = pt.matrix(self.model.tangent(state), self.part)
         _lifted(K, R, self.rows,

@@ -47,6 +47,7 @@ import skfem as fem
 
 from ..discretization.basis import FamilyBasis
 from ..discretization.blend import BlendBasis
+from ..discretization.follower import FollowerPressure
 from ..discretization.loads import (call_user, fe_traction,
                                     traction as pg_traction)
 from ..discretization.particles import Particles, linear_elements
@@ -56,6 +57,7 @@ from ..formulations.updated_lagrange import UpdatedLagrange
 from ..keys import exact
 from ..naming import fe_method, formulation_of, frame_of, parse
 from ..solvers import newton
+from ..solvers.static import external_load
 from ..solvers.problem import Problem
 from ..solvers.result import Result
 from .. import distributed, registry
@@ -89,6 +91,13 @@ class Scene:
         or a callable of the facet quadrature points ``x`` ``(d, nfacets,
         nqp)`` returning ``(d, nfacets, nqp)``, on FE and PG alike
         (:func:`skfem_pg.traction`).
+    pressures
+        ``{boundary: p}`` follower pressures at load factor 1, acting on
+        the deformed surface (positive: against the outward normal): a
+        number or a callable of the facets' reference midpoints ``(d,
+        nfacets)``; on PG and linear FE
+        (:class:`~skfem_pg.discretization.follower.FollowerPressure`),
+        solved by Newton (serial).
     probes
         ``{label: point}`` where displacements are reported.
     steps
@@ -119,11 +128,13 @@ class Scene:
                  prescribed: dict | None = None,
                  tractions: dict | None = None,
                  probes: dict | None = None, steps: int = 1,
-                 params: dict | None = None) -> None:
+                 params: dict | None = None,
+                 pressures: dict | None = None) -> None:
         self.name, self.mesh, self.material = name, mesh, material
         self.clamped = tuple(clamped)
         self.prescribed = prescribed or {}
         self.tractions = tractions or {}
+        self.pressures = pressures or {}
         self.probes = {k: np.asarray(v, float)
                        for k, v in (probes or {}).items()}
         self.steps = steps
@@ -166,7 +177,8 @@ class Scene:
         scikit-fem at :meth:`solve`)."""
         named = list(self.clamped) + [k for k in self.prescribed
                                       if isinstance(k, str)] + [
-            k for k in self.tractions if isinstance(k, str)]
+            k for k in self.tractions if isinstance(k, str)] + list(
+            self.pressures)
         have = sorted((self.mesh.boundaries or {}).keys())
         missing = sorted(set(named) - set(have))
         if missing:
@@ -191,7 +203,10 @@ class Scene:
                      exact({k: v if callable(v) else np.asarray(v, float)
                             for k, v in self.tractions.items()}),
                      exact(self.probes), exact(self.params),
-                     exact(self.steps)))
+                     exact(self.steps)) + ((exact({
+                         k: v if callable(v) else float(v)
+                         for k, v in self.pressures.items()}),)
+                         if self.pressures else ()))
 
     def load_samples(self):
         """The values of every callable load at points where it acts: a
@@ -214,6 +229,11 @@ class Scene:
             if callable(t):
                 out.append((name, call_user(t, points(name),
                                             "the traction on {!r}"
+                                            .format(name))))
+        for name, p in sorted(self.pressures.items()):
+            if callable(p):
+                out.append((name, call_user(p, points(name).mean(axis=2),
+                                            "the pressure on {!r}"
                                             .format(name))))
         for name, how in sorted(self.prescribed.items()):
             if callable(how):
@@ -382,7 +402,6 @@ class Scene:
                                            tol, solver, basis_kwargs)
         setup = self.setup(scheme, mesh, tangent, **basis_kwargs)
         basis, model, t_pre = setup.basis, setup.model, setup.seconds
-        f = setup.f_ext
         x, hist = newton(setup.problem, steps=self.steps, solver=solver,
                          verbose=verbose, tol=tol)
         times = {"preprocess": t_pre,
@@ -393,6 +412,7 @@ class Scene:
         plastic = model.plastic_strain()
         if plastic is not None:  # per family (particle) or per cell
             fields["ep"] = plastic[0]
+        f = external_load(setup.f_ext, model.n_u, model.n_u).vector(x)
         return Result(scheme, u, basis, self.evaluate(basis, u), times, hist,
                       fields=fields, model=model, x=x, f_ext=f)
 
@@ -403,6 +423,10 @@ class Scene:
             raise NotImplementedError(
                 "PG2 on MPI: the blended quadratic basis is serial; the "
                 "distributed solver runs 'PG' and the thesis' names")
+        if self.pressures:
+            raise NotImplementedError(
+                "follower pressures on MPI: the distributed Newton takes "
+                "dead loads; solve scene {!r} serially".format(self.name))
         if method != "PG":
             raise NotImplementedError(
                 "{} on MPI: FE methods run on scikit-fem's own distributed "
@@ -463,6 +487,10 @@ class Scene:
             f = sum((pg_traction(basis, n, t)
                      for n, t in self.tractions.items()), np.zeros(basis.N))
         elif method == "PG2":
+            if self.pressures:
+                raise NotImplementedError(
+                    "follower pressures on the blended quadratic basis "
+                    "(PG2): they act on PG and linear FE")
             mesh = self.mesh if mesh is None else mesh
             basis = BlendBasis(Particles.from_mesh(mesh), dim=self.dim,
                                **basis_kwargs)
@@ -492,6 +520,9 @@ class Scene:
             raise ValueError("unknown method {!r}: 'PG' or one of {}".format(
                 method, ", ".join(registry.fe_names())))
         D, u_D = self._dirichlet(basis)
+        if self.pressures:  # the dead load beside the follower loads
+            f = [f] + [FollowerPressure(basis, name, p)
+                       for name, p in sorted(self.pressures.items())]
         return Setup(basis, model, f, D, u_D, time.perf_counter() - t0)
 
     def evaluate(self, basis, u, particles=None):
@@ -538,6 +569,9 @@ def _scheme(scheme, basis_kwargs):
 class Setup(NamedTuple):
     """What :meth:`Scene.setup` returns; unpacks as ``basis, model, f_ext,
     D, u_D, seconds`` (``seconds``: the time spent making them).
+    ``f_ext`` is the dead load vector, or with ``pressures`` the list of
+    it and the follower loads, which :func:`~skfem_pg.solvers.newton`
+    takes as it is.
 
     Examples
     --------

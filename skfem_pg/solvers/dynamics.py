@@ -38,6 +38,7 @@ from ..errors import FamilyError, ParticleError
 from ..progress import Echo
 from .checkpoint import load as load_checkpoint
 from .exchange import SerialExchange
+from ..discretization.follower import split_loads
 from .static import padded_vector
 
 
@@ -45,6 +46,11 @@ def time_functions(model, f_ext, u_D):
     """``f(t)`` and ``u_D(t)`` as full-length vectors (one entry per
     unknown) from a vector, a callable of the time or ``None``."""
     N, n_u = model.N, model.n_u
+    if split_loads(f_ext)[1]:
+        raise NotImplementedError(
+            "follower loads (FollowerPressure) in the time integrators: "
+            "newton takes them; newmark and central_difference take dead "
+            "load vectors or callables of the time")
 
     def wrap(v, what):
         if callable(v):

@@ -29,6 +29,7 @@ from .checkpoint import Every, load as load_checkpoint
 from .controls import NewtonControls, check_controls
 from ..progress import Echo
 from .linear import linear_solver, submatrix
+from ..discretization.follower import split_loads
 from ..discretization.layout import is_family_basis
 
 
@@ -51,7 +52,10 @@ class ConvergenceError(RuntimeError):
 PG_CANDIDATES = 12
 
 
-def condensed_solver(kind, basis, I, extra_fields=False):
+def condensed_solver(kind, basis, I, extra_fields=False, symmetric=None):
+    """The linear solver of the free dofs ``I``; ``symmetric=None``: as
+    the basis says (a Petrov–Galerkin basis is not), ``False``: not
+    (a follower load's stiffness)."""
     if extra_fields:  # a saddle point or a coupled u-p system: no
         # rigid-body AMG; the direct solve (partial pivoting)
         if kind == "amg":
@@ -63,7 +67,8 @@ def condensed_solver(kind, basis, I, extra_fields=False):
     # scikit-fem's vector dofs (and the family bases') are interleaved:
     # dof j is component j % d of its node, also for a subset of them
     return linear_solver(kind, None if locs is None else locs[:, I],
-                         symmetric=getattr(basis, "test", None) is None,
+                         symmetric=getattr(basis, "test", None) is None
+                         and symmetric is not False,
                          candidates=PG_CANDIDATES if is_family_basis(basis)
                          else 0,
                          components=None if locs is None
@@ -172,7 +177,7 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     Dd = as_dofs(D, n_u, "Dirichlet (displacement) dofs")
     check_sliding(basis, Dd)
     I = np.setdiff1d(np.arange(N), Dd)
-    f_ext = padded_vector(f_ext, n_u, N, "f_ext")
+    f_ext = external_load(f_ext, n_u, N)
     if callable(u_D):
         values = u_D
 
@@ -186,7 +191,8 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     x0 = model.initial() if hasattr(model, "initial") else np.zeros(N)
     u = x0 if u0 is None else padded_vector(u0, n_u, N, "u0", x0)
     lin = solver if callable(solver) else condensed_solver(
-        solver, basis, I, extra_fields=N > n_u)
+        solver, basis, I, extra_fields=N > n_u,
+        symmetric=not f_ext.followers and None)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam = float(load0)
     dlam = (1.0 - lam) / opts.steps if lam < 1.0 else 1.0
@@ -384,6 +390,49 @@ class LinearSolveFailed(RuntimeError):
     tangent); its message is the iteration's ``reason``."""
 
 
+class ExternalLoad:
+    """The external force of a static run at load factor 1: a dead vector
+    ``(N,)`` and deformation-dependent loads (``force(u)``,
+    ``stiffness(u)`` on the displacement dofs, e.g.
+    :class:`~skfem_pg.discretization.follower.FollowerPressure`)."""
+
+    def __init__(self, dead, followers, n_u=None):
+        self.dead, self.followers = dead, tuple(followers)
+        self.n_u = len(dead) if n_u is None else n_u
+        self.norm = float(np.linalg.norm(self.vector(np.zeros(len(dead)))))
+
+    def vector(self, u):
+        """The force at the unknowns ``u``."""
+        if not self.followers:
+            return self.dead
+        f = self.dead.copy()
+        for load in self.followers:
+            f[:self.n_u] += load.force(u[:self.n_u])
+        return f
+
+    def tangent(self, K, u, lam):
+        """``K - lam * df/du``: the loads' share of Newton's tangent."""
+        for load in self.followers:
+            Kf = load.stiffness(u[:self.n_u]).tocoo()
+            K = K - lam * type(K)((Kf.data, (Kf.row, Kf.col)),
+                                  shape=K.shape)
+        return K
+
+
+def external_load(f_ext, n_u, N):
+    """:class:`ExternalLoad` of a driver's ``f_ext``: a vector, a load
+    with ``force`` / ``stiffness``, or a list of both."""
+    dead, followers = split_loads(f_ext)
+    for load in followers:
+        if load.N != n_u:
+            raise ValueError(
+                "{} acts on {} dofs, the model has {} displacement dofs: "
+                "build it on the model's basis".format(
+                    type(load).__name__, load.N, n_u))
+    return ExternalLoad(padded_vector(dead, n_u, N, "f_ext"), followers,
+                        n_u)
+
+
 class SerialAlgebra:
     """The linear algebra of :func:`newton_iterations` on one process:
     NumPy vectors of all unknowns in scikit-fem's numbering, residuals and
@@ -393,6 +442,8 @@ class SerialAlgebra:
 
     def __init__(self, model=None, f_ext=None, Dd=None, I=None, lin=None,
                  kept=None):
+        if f_ext is not None and not isinstance(f_ext, ExternalLoad):
+            f_ext = ExternalLoad(np.asarray(f_ext, dtype=float), ())
         self.model, self.f_ext, self.Dd, self.I, self.lin = (
             model, f_ext, Dd, I, lin)
         self.kept = kept  # a KeptTangent (modified Newton) or None
@@ -441,23 +492,25 @@ class SerialAlgebra:
     def min_J(self, state):
         return self.model.min_J(state)
 
-    def residual(self, state, lam):
-        """``(r, |r_free|, f_int)`` at load factor ``lam``."""
+    def residual(self, state, lam, u):
+        """``(r, |r_free|, f_int)`` at load factor ``lam`` and unknowns
+        ``u``."""
         f_int = self.model.internal_force(state)
-        r = f_int - lam * self.f_ext
+        r = f_int - lam * self.f_ext.vector(u)
         return r, float(np.linalg.norm(r[self.I])), f_int
 
     def load_norm(self, lam):
-        return lam * np.linalg.norm(self.f_ext)
+        return lam * self.f_ext.norm
 
-    def solve(self, state, u, r, du_D, first):
+    def solve(self, state, u, r, du_D, first, lam=1.0):
         """The Newton increment (with the prescribed increment ``du_D``,
         or ``None``) and its energy :math:`|\\Delta x\\cdot r|`; returns
         ``(du, energy, t_assemble, t_linear)``."""
         I, Dd, kept = self.I, self.Dd, self.kept
         t0 = time.perf_counter()
         self.reused = kept is not None and kept.usable()
-        K = kept.K if self.reused else self.model.tangent(state).tocsr()
+        K = kept.K if self.reused else self.f_ext.tangent(
+            self.model.tangent(state).tocsr(), u, lam)
         t1 = time.perf_counter()
         du = np.zeros_like(u)
         rhs = -r[I]
@@ -569,7 +622,7 @@ def _iterate(algebra, u, lam, info):
         if not info["min_J"] > 0:
             fail = "J <= 0"
     if fail is None:
-        r, rn, f_int = algebra.residual(state, lam)
+        r, rn, f_int = algebra.residual(state, lam, u)
         if not np.isfinite(rn):
             fail = "non-finite residual"
     info["t_assemble"] += time.perf_counter() - t0
@@ -658,7 +711,7 @@ def newton_iterations(model, algebra, u, lam, prescribed, tol, maxiter,
             return False, u, info, None
         try:
             du, e, t_asm, t_lin = algebra.solve(
-                state, u, r, du_D if pending else None, it == 0)
+                state, u, r, du_D if pending else None, it == 0, lam)
         except LinearSolveFailed as err:
             info["reason"] = str(err)
             return False, u, info, None
