@@ -48,7 +48,7 @@ CORNER = (48.0, 60.0, T)
 RESULTS = os.path.join(HERE, "README.md")  # measured tables, written here
 OUT = output_dir(create=False)  # --out, $SKFEM_PG_OUT or ./out
 LAM, MU = 100.0, 40.0
-MATERIAL = mat.LinearElastic(LAM, MU)
+MATERIAL = mat.LinearElastic(lam=LAM, mu=MU)
 AREA = 0.5 * (44.0 + 16.0) * 48.0  # the Cook outline
 KAPPA = 1e-3
 Q = 0.04  # linear: any load; the nonlinear demo uses 4

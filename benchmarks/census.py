@@ -62,7 +62,7 @@ def bar():
     return basis, D, v0
 
 def unl(basis):
-    return model_for("Unl", basis, mat.NeoHookeIsoVol(40.0, 80.0))
+    return model_for("Unl", basis, mat.NeoHookeIsoVol(mu=40.0, K=80.0))
 
 def two_triangulations(n=4):
     quads = fem.MeshQuad.init_tensor(*(np.linspace(0, 1, n),) * 2)
@@ -212,21 +212,21 @@ CASES = [
     # -- scenes and the reference cache ------------------------------------
     case("clamped-and-moved", "scene", I47, """
         from skfem_pg.scenes import Scene
-        sc = Scene("both", strip(), mat.NeoHooke(10.0, 4.0),
+        sc = Scene("both", strip(), mat.NeoHooke(lam=10.0, mu=4.0),
                    clamped=["right"], prescribed={"right": {0: 0.1}})
         sc.setup("PG")
         result = None
         """, ["right", "clamped", "prescribed"]),
     case("component-out-of-range", "scene", I47, """
         from skfem_pg.scenes import Scene
-        sc = Scene("bad", strip(), mat.NeoHooke(10.0, 4.0),
+        sc = Scene("bad", strip(), mat.NeoHooke(lam=10.0, mu=4.0),
                    clamped=["left"], prescribed={"right": {2: 0.1}})
         sc.setup("PG")
         result = None
         """, ["component 2"]),
     case("prescribed-nan", "scene", OWN, """
         from skfem_pg.scenes import Scene
-        sc = Scene("bad", strip(), mat.NeoHooke(10.0, 4.0),
+        sc = Scene("bad", strip(), mat.NeoHooke(lam=10.0, mu=4.0),
                    clamped=["left"], prescribed={"right": {0: float("nan")}})
         sc.setup("PG")
         result = None
@@ -236,7 +236,7 @@ CASES = [
         m = strip().with_boundaries({
             "left": lambda x: np.isclose(x[0], 0),
             "bottom": lambda x: np.isclose(x[1], 0)})
-        sc = Scene("c", m, mat.NeoHooke(10.0, 4.0),
+        sc = Scene("c", m, mat.NeoHooke(lam=10.0, mu=4.0),
                    prescribed={"left": {1: 0.0}, "bottom": {1: 0.2}})
         sc.setup("PG")
         result = None
@@ -247,11 +247,12 @@ CASES = [
         def key(A=792.0, D1=0.05, sy=None):
             if sy is None:
                 law = mat.J2Plasticity(
-                    80.0, 160.0,
+                    mu=80.0, K=160.0,
                     hardening=mat.JohnsonCookHardening(A, 510.0, 0.26),
                     damage=mat.JohnsonCookDamage(D1, 3.44, -2.12, 1.0))
             else:
-                law = mat.J2Plasticity(80.0, 160.0, sy, H=0.13)
+                law = mat.J2Plasticity(mu=80.0, K=160.0, sigma_y0=sy,
+                                        H=0.13)
             sc = Scene("law", strip(), law, clamped=["left"],
                        prescribed={"right": {0: 0.01}})
             return sc.fingerprint(2, "Q2", {"tol": 1e-9})
@@ -272,7 +273,7 @@ CASES = [
             return Hyperelastic(basis, material, tangent=tangent)
         pg.register_formulation("Q1", "MTE1", build)
         from skfem_pg.scenes import Scene
-        sc = Scene("q", strip(), mat.NeoHooke(10.0, 4.0), clamped=["left"],
+        sc = Scene("q", strip(), mat.NeoHooke(lam=10.0, mu=4.0), clamped=["left"],
                    tractions={"right": [0.0, 0.01]})
         sc.setup("Q1")
         result = calls
@@ -286,7 +287,7 @@ CASES = [
         pg.register_formulation("MyUL", "MTE1", build,
                                 updated_lagrangian=True)
         from skfem_pg.scenes import Scene
-        sc = Scene("u", strip(), mat.NeoHooke(10.0, 5.0), clamped=["left"],
+        sc = Scene("u", strip(), mat.NeoHooke(lam=10.0, mu=5.0), clamped=["left"],
                    tractions={"right": [0.0, 0.1]}, steps=2)
         sc.setup("VCPBG V5m MyUL UL")
         result = calls
@@ -294,7 +295,7 @@ CASES = [
     case("register-wrong-signature", "registry", I47, """
         pg.register_formulation("Two", "MTE1", lambda basis, material: 0)
         from skfem_pg.scenes import Scene
-        sc = Scene("t", strip(), mat.NeoHooke(10.0, 4.0), clamped=["left"],
+        sc = Scene("t", strip(), mat.NeoHooke(lam=10.0, mu=4.0), clamped=["left"],
                    tractions={"right": [0.0, 0.01]})
         sc.setup("VCPBG V5m Two")
         result = None
@@ -556,12 +557,12 @@ CASES = [
         """, ["rho"]),
     case("scene-unknown-boundary", "scene", OWN, """
         from skfem_pg.scenes import Scene
-        Scene("x", strip(), mat.NeoHooke(10.0, 4.0), clamped=["nope"])
+        Scene("x", strip(), mat.NeoHooke(lam=10.0, mu=4.0), clamped=["nope"])
         result = None
         """, ["nope"]),
     case("scene-traction-3-components-in-2d", "scene", OWN, """
         from skfem_pg.scenes import Scene
-        Scene("x", strip(), mat.NeoHooke(10.0, 4.0), clamped=["left"],
+        Scene("x", strip(), mat.NeoHooke(lam=10.0, mu=4.0), clamped=["left"],
               tractions={"right": [0.0, 1.0, 0.0]}).solve("PG")
         result = None
         """, ["2 components"]),

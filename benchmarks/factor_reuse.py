@@ -137,7 +137,7 @@ def punch(nx):
     mod = demo("punch")
     mesh = mod.block(nx, nx // 2)
     lam, mu = pg.materials.lame(mod.E, mod.NU)
-    material = pg.materials.NeoHooke(lam, mu)
+    material = pg.materials.NeoHooke(lam=lam, mu=mu)
 
     def solve(basis):
         def run(newton):

@@ -30,7 +30,7 @@ from harness import (demo_parser, markdown_table, output_dir, save_figure,
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 RESULTS = os.path.join(HERE, "README.md")
-MATERIAL = mat.NeoHookeIsoVol(1.0, 10.0)  # the spaces do not depend on it
+MATERIAL = mat.NeoHookeIsoVol(mu=1.0, K=10.0)  # the spaces do not depend on it
 
 
 def node_set(N, distorted):

@@ -109,7 +109,7 @@ def cook_2d(ns):
 
 
 def cook_3d(grids):
-    material = mat.LinearElastic(100.0, 40.0)
+    material = mat.LinearElastic(lam=100.0, mu=40.0)
     corner = (48.0, 60.0, 10.0)
 
     def scene(mesh):

@@ -33,7 +33,7 @@ from harness import (demo_parser, markdown_table, update_results)
 
 RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        "README.md")
-MATERIAL = mat.NeoHookeIsoVol(1.0, 1e3)
+MATERIAL = mat.NeoHookeIsoVol(mu=1.0, K=1e3)
 INCOMPRESSIBLE = mat.NeoHookeIsoVol.incompressible(1.0)
 
 #: label -> (thesis name of the basis, formulation token)

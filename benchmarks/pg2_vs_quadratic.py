@@ -56,7 +56,7 @@ def pg2_compliance(mesh, spec):
     basis = pg.FamilyBasis(mesh, dim=2, order=2)
     conditions = [(mesh.facets_satisfying(select), {c: 0.0 for c in comps})
                   for select, comps in clamps]
-    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(100.0, 40.0)),
+    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(lam=100.0, mu=40.0)),
                           conditions)
     f = pg.traction(basis, mesh.facets_satisfying(loaded), list(t))
     s = model.state(np.zeros(basis.N))

@@ -123,6 +123,10 @@ SCRIPTS = [
     ("newton_3d", ["benchmarks/newton_3d.py"],
      "one 3-D Newton iteration, PG vs O1 / H1P0: material, assembly, "
      "solve", "20 min", 1200),
+    ("material_library", ["benchmarks/material_library.py"],
+     "FElupe's laws through FElupeMaterial against the package's: stress "
+     "and tangent at 1e5 points, Newton on FElupe's cube (H1, PG)",
+     "10 s", 30),
     ("factor_reuse", ["benchmarks/factor_reuse.py"],
      "modified Newton (reuse=True) against full Newton: whole solves of "
      "the 3-D Cook, a bracket, necking, the punch", "5 min", 600),

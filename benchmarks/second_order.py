@@ -250,7 +250,7 @@ def blend(mesh, beta=20.0, field=FIELD):
     d = mesh.dim()
     mesh = mesh.with_boundaries({"all": mesh.boundary_facets()})
     basis = pg.FamilyBasis(mesh, dim=d, order=2)
-    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(LAM, MU)),
+    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(lam=LAM, mu=MU)),
                           {"all": field}, penalty=beta)
     b = field.body_force(LAM, MU)
     f = pg.assemble(fem.LinearForm(lambda v, w: dot(b(np.asarray(w.x)), v)),

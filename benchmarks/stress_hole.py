@@ -150,7 +150,7 @@ KIRSCH_NODE_SETS = {
 
 
 def kirsch_study(quick):
-    material = LinearElastic(LAM, MU)
+    material = LinearElastic(lam=LAM, mu=MU)
     parts = []
     for label, (make, sizes, quick_sizes) in KIRSCH_NODE_SETS.items():
         rows = []
@@ -259,7 +259,7 @@ def ellipse_study(sizes, ref_sizes):
         print("reference", refs[-1], flush=True)
     (n0, tip0, lig0), (n1, tip, lig) = refs
     ref = np.array([tip, lig])
-    material = LinearElastic(E_LAM, E_MU)
+    material = LinearElastic(lam=E_LAM, mu=E_MU)
     parts = []
     for quad in (False, True):
         rows = []

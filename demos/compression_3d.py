@@ -35,7 +35,7 @@ from skfem_pg.scenes import Scene
 from harness import (demo_parser, markdown_table, update_results)
 from skfem_pg.solvers import ConvergenceError, newton
 
-MATERIAL = mat.NeoHookeIsoVol(1.0, 2.0)
+MATERIAL = mat.NeoHookeIsoVol(mu=1.0, K=2.0)
 STRAIN = 0.3
 
 

@@ -95,8 +95,8 @@ def main(n=16, steps=500, variants=None, results=None, out=None, q0=Q0):
     out = output_dir(out)
     print(pg.threads.describe())
     sc = Scene("cook-dynamic", pg.meshing.cook_membrane(n),
-               NeoHooke(E * NU / ((1 + NU) * (1 - 2 * NU)),
-                        E / (2 * (1 + NU))),
+               NeoHooke(lam=E * NU / ((1 + NU) * (1 - 2 * NU)),
+                        mu=E / (2 * (1 + NU))),
                clamped=["left"])
     print("dynamic Cook membrane, {} particles, {} Newmark steps over {} µs,"
           " q0 = {} kN/mm for {} µs".format(sc.mesh.nvertices, steps, T_END,

@@ -38,7 +38,7 @@ from harness import (demo_parser, markdown_table, output_dir,
                      wall_time)
 
 G, LAM = 0.375, 7.5e6
-MATERIAL = mat.NeoHookeIsoVol(G, LAM + 2.0 * G / 3.0)
+MATERIAL = mat.NeoHookeIsoVol(mu=G, K=LAM + 2.0 * G / 3.0)
 LOAD = 1e-5  # total shear; results are divided by it
 POINT = (48.0, 52.0)
 PUBLISHED = 16.4326

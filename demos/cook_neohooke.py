@@ -56,7 +56,7 @@ STYLES = {"T1": "k--o", "PBG Unl": "C2-v", "VC PBG Unl": "C0-D",
 
 
 def scene(mesh):
-    return Scene("cook-neohooke", mesh, mat.NeoHooke(LAM, MU),
+    return Scene("cook-neohooke", mesh, mat.NeoHooke(lam=LAM, mu=MU),
                  clamped=["left"],
                  tractions={"right": [0.0, TOTAL_SHEAR / 16.0]},
                  probes={"tip": TIP}, steps=1)
@@ -133,7 +133,7 @@ def main(sizes=(4.0, 2.0, 1.0), ref_size=1.0, ref_refine=1, results=None):
     save_error_vs_time(os.path.join(OUT, "cook_neohooke.png"), rows, STYLES,
                        "relative error of v(48, 60)",
                        "Cook's membrane, neo-Hooke, irregular triangle nodes")
-    fields = particle_fields(last.basis, mat.NeoHooke(LAM, MU), last.u)
+    fields = particle_fields(last.basis, mat.NeoHooke(lam=LAM, mu=MU), last.u)
     pg.write_vtu(os.path.join(OUT, "cook_neohooke.vtu"),
                  last.basis.particles, **fields)
     print("\nwrote " + OUT + "/cook_neohooke.png and cook_neohooke.vtu")

@@ -124,7 +124,7 @@ def main(n=16, results=None):
     # the reference resolves the circle itself (a refinement of the coarse
     # mesh would keep its polygon, whose corners are stress singularities)
     fine = pg.meshing.plate_with_hole(A, L, n=REF_FACTOR * n)
-    scene = Scene("plate-hole", fine, mat.LinearElastic(lam, mu),
+    scene = Scene("plate-hole", fine, mat.LinearElastic(lam=lam, mu=mu),
                   prescribed={"left": {0: 0.0}, "bottom": {1: 0.0}},
                   tractions={"right": [SIGMA, 0.0]},
                   probes={"A": (0.0, A)})

@@ -70,7 +70,7 @@ def compress(basis, material, min_step=1e-3):
 
 def main(nx=64, ny=32, results=None):
     lam, mu = pg.materials.lame(E, NU)
-    material = mat.NeoHooke(lam, mu)
+    material = mat.NeoHooke(lam=lam, mu=mu)
     mesh = block(nx, ny)
     runs = {
         "Q1": fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1())),

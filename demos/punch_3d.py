@@ -54,7 +54,7 @@ METHODS = ["H1", "H1P0", "PBG Unl", "VCBCPBG V5m Unl", "VCBCPBG V5m UnlP0",
 def material(nu):
     if nu == 0.5:
         return mat.NeoHookeIsoVol.incompressible(E / 3.0)
-    return mat.NeoHookeIsoVol(E / (2 * (1 + nu)), E / (3 * (1 - 2 * nu)))
+    return mat.NeoHookeIsoVol(mu=E / (2 * (1 + nu)), K=E / (3 * (1 - 2 * nu)))
 
 
 def block(n):

@@ -111,7 +111,7 @@ def simulate(basis, material, stretch, periods, record=8):
 def main(periods=10, size=0.11):
     mesh, p, fam = patch(size)
     lam, mu = lame(1.0, 0.3)
-    material = mat.NeoHooke(lam, mu)
+    material = mat.NeoHooke(lam=lam, mu=mu)
     print("free patch: {} centroid particles, families {}..{} members, "
           "10 % isotropic stretch, {} breathing periods".format(
               p.n, fam.sizes.min(), fam.sizes.max(), periods))

@@ -43,7 +43,7 @@ from harness import (demo_parser, markdown_table, output_dir, save_figure,
 from skfem_pg.solvers import ConvergenceError, newton
 
 A, L = 1e-3, 5e-3
-MATERIAL = mat.NeoHookeIsoVol(1.61148e8, 5e8)
+MATERIAL = mat.NeoHookeIsoVol(mu=1.61148e8, K=5e8)
 #: Table 7.4: method -> (max step [deg], steps / 360)
 THESIS = {"FEM H1": (7, 72), "FEM H1P0": (42, 9), "PPG Unl": (17, 60),
           "PPG UnlP0": (64, 6), "PBG Unl": (12, 72), "PBG U2": (4, 90),

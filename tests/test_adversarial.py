@@ -18,7 +18,7 @@ from skfem_pg.scenes.reference import cache_dir, overkill
 from skfem_pg.solvers import (RigidWall, central_difference, direct,
                               linear_solver, lumped_mass, newmark, newton)
 
-ELASTIC = mat.LinearElastic(1.0, 1.0)
+ELASTIC = mat.LinearElastic(lam=1.0, mu=1.0)
 
 
 def _strip(nx=6, ny=2):
@@ -55,7 +55,7 @@ def _global_traction(x):
 
 
 def _scene(name="adv", traction=_global_traction, steps=1):
-    return Scene(name, _strip(3, 1), mat.NeoHooke(2.0, 1.0),
+    return Scene(name, _strip(3, 1), mat.NeoHooke(lam=2.0, mu=1.0),
                  clamped=["left"], tractions={"right": traction},
                  probes={"tip": (3.0, 1.0)}, steps=steps)
 
@@ -183,7 +183,7 @@ def test_j2_parameters_are_finite(kw):
     args.update(kw)
     with pytest.raises(ValueError, match=list(kw)[0]):
         mat.J2Plasticity(**args)
-    assert mat.J2Plasticity(1.0, np.inf, 0.1).K == np.inf  # documented
+    assert mat.J2Plasticity(mu=1.0, K=np.inf, sigma_y0=0.1).K == np.inf  # documented
 
 
 # -- 6. names -------------------------------------------------------------
@@ -385,7 +385,7 @@ def test_a_held_mode_of_a_nearly_incompressible_body_is_not_called_free():
     it free and refused the solve (the cook_incompressible overkill)."""
     g = 0.375
     sc = Scene("held-mode", pg.meshing.cook_membrane(16),
-               mat.NeoHookeIsoVol(g, 7.5e8 + 2.0 * g / 3.0),
+               mat.NeoHookeIsoVol(mu=g, K=7.5e8 + 2.0 * g / 3.0),
                clamped=["left"], tractions={"right": [0.0, 1e-6]},
                probes={"v": (48.0, 52.0)})
     r = sc.solve("Q1P0", solver="direct")

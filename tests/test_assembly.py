@@ -29,7 +29,7 @@ def test_elasticity_fast_equals_generic(mesh):
     from skfem_pg.formulations import material_tangent
     F = b.interpolate(0.05 * np.random.default_rng(2).standard_normal(
         b.N)).grad + np.eye(d)[:, :, None, None]
-    A = NeoHooke(3.0, 1.0).tangent(F)
+    A = NeoHooke(lam=3.0, mu=1.0).tangent(F)
     assert rel(pg.assemble(material_tangent, b, A=A),
                material_tangent.assemble(b, A=A)) < 1e-13
 
@@ -113,8 +113,8 @@ def test_fe_cell_bases_fast_equals_generic(mesh_elem):
         + np.eye(d)[:, :, None, None]
     from skfem_pg.materials import NeoHooke
     from skfem_pg.formulations import material_tangent, internal_force
-    A = NeoHooke(3.0, 1.0).tangent(F)
-    P = NeoHooke(3.0, 1.0).stress(F)
+    A = NeoHooke(lam=3.0, mu=1.0).tangent(F)
+    P = NeoHooke(lam=3.0, mu=1.0).stress(F)
     assert rel(pg.assemble(material_tangent, vb, A=A),
                material_tangent.assemble(vb, A=A)) < 1e-13
     assert rel(pg.assemble(internal_force, vb, P=P),

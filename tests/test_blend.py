@@ -42,7 +42,7 @@ def solve_weak(mesh, g, body, material=None):
     d = mesh.dim()
     basis = pg.FamilyBasis(mesh, dim=d, order=2)
     model = WeakDirichlet(Hyperelastic(
-        basis, material or LinearElastic(LAM, MU)), {"all": g})
+        basis, material or LinearElastic(lam=LAM, mu=MU)), {"all": g})
     f = pg.assemble(linear_form(lambda v, w: sum(
         body(np.asarray(w.x))[a] * v[a] for a in range(d))), basis) \
         + model.load()
@@ -140,7 +140,7 @@ def test_rollers_and_traction_give_uniaxial_tension_exactly():
         "left": lambda x: x[0] == 0, "bottom": lambda x: x[1] == 0,
         "right": lambda x: x[0] == 1})
     basis = pg.FamilyBasis(mesh, dim=2, order=2)
-    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(LAM, MU)),
+    model = WeakDirichlet(Hyperelastic(basis, LinearElastic(lam=LAM, mu=MU)),
                           {"left": {0: 0.0}, "bottom": {1: 0.0}})
     s = model.state(np.zeros(basis.N))
     f = pg.traction(basis, "right", [1.0, 0.0]) + model.load()
@@ -249,11 +249,11 @@ def test_refused_inputs():
     basis = pg.FamilyBasis(mesh, dim=2, order=2)
     with pytest.raises(NotImplementedError, match="stateful|history"):
         WeakDirichlet(Hyperelastic(basis, J2Plasticity(
-            MU, LAM + MU, 1.0)), {"left": None})
+            mu=MU, K=LAM + MU, sigma_y0=1.0)), {"left": None})
     with pytest.raises(ValueError, match="component"):
-        WeakDirichlet(Hyperelastic(basis, NeoHooke(LAM, MU)),
+        WeakDirichlet(Hyperelastic(basis, NeoHooke(lam=LAM, mu=MU)),
                       {"left": {2: 0.0}})
-    sc = Scene("s", mesh, NeoHooke(LAM, MU),
+    sc = Scene("s", mesh, NeoHooke(lam=LAM, mu=MU),
                prescribed={"left": lambda x, t: 0 * x})
     with pytest.raises(NotImplementedError, match="f\\(x, t\\)"):
         sc.solve("PG2", verbose=False)

@@ -117,7 +117,7 @@ def _bar():
 @pytest.mark.parametrize("integrator", ["newmark", "central"])
 def test_a_dynamic_run_resumes_to_round_off(tmp_path, integrator):
     basis, D, v0 = _bar()
-    material = NeoHookeIsoVol(40.0, 80.0)
+    material = NeoHookeIsoVol(mu=40.0, K=80.0)
     m = lumped_mass(basis, 1.0)
 
     def run(**kw):
@@ -149,7 +149,7 @@ def test_a_checkpoint_knows_its_driver_and_what_it_holds(tmp_path):
     NaN, the wrong length); a plain .npz and an older format are named
     as such."""
     basis, D, v0 = _bar()
-    material = NeoHookeIsoVol(40.0, 80.0)
+    material = NeoHookeIsoVol(mu=40.0, K=80.0)
     m = lumped_mass(basis, 1.0)
     model = model_for("Unl", basis, material)
     ck = checkpoint.Every(tmp_path / "dyn", steps=5)
@@ -208,7 +208,7 @@ def test_a_checkpoint_of_another_triangulation_is_refused(tmp_path):
     q = quads.t
     a = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 2]], q[[0, 2, 3]]]))
     b = fem.MeshTri(quads.p, np.hstack([q[[0, 1, 3]], q[[1, 2, 3]]]))
-    material = NeoHookeIsoVol(40.0, 80.0)
+    material = NeoHookeIsoVol(mu=40.0, K=80.0)
     ma = model_for("Unl", pg.FamilyBasis(a, dim=2), material)
     mb = model_for("Unl", pg.FamilyBasis(b, dim=2), material)
     path = checkpoint.save(tmp_path / "a", ma, np.zeros(ma.N), 0.5)

@@ -21,12 +21,12 @@ def test_lame_rejects_non_physical_constants(E, nu, match):
 
 
 @pytest.mark.parametrize("make, match", [
-    (lambda: mat.NeoHooke(1.0, -2.0), "shear"),
-    (lambda: mat.NeoHooke(-1.0, 1.0), "bulk"),
-    (lambda: mat.StVenantKirchhoff(1.0, 0.0), "shear"),
-    (lambda: mat.LinearElastic(np.inf, 1.0), "finite"),
-    (lambda: mat.NeoHookeIsoVol(1.0, 0.0), "bulk modulus K"),
-    (lambda: mat.NeoHookeIsoVol(-1.0, 1.0), "shear"),
+    (lambda: mat.NeoHooke(lam=1.0, mu=-2.0), "shear"),
+    (lambda: mat.NeoHooke(lam=-1.0, mu=1.0), "bulk"),
+    (lambda: mat.StVenantKirchhoff(lam=1.0, mu=0.0), "shear"),
+    (lambda: mat.LinearElastic(lam=np.inf, mu=1.0), "finite"),
+    (lambda: mat.NeoHookeIsoVol(mu=1.0, K=0.0), "bulk modulus K"),
+    (lambda: mat.NeoHookeIsoVol(mu=-1.0, K=1.0), "shear"),
     (lambda: linear_elasticity(1.0, -1.0), "shear")])
 def test_materials_reject_non_physical_constants(make, match):
     with pytest.raises(ValueError, match=match):
@@ -70,14 +70,14 @@ def test_loads_reject_wrong_shapes(square):
     (np.ones(50, dtype=bool), "boolean"), (np.array([0.5, 1.0]), "integer")])
 def test_newton_rejects_bad_dirichlet_dofs(square, D, match):
     _, b = square
-    model = Hyperelastic(b, mat.NeoHooke(1.0, 1.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=1.0, mu=1.0))
     with pytest.raises(ValueError, match=match):
         pg.solvers.newton(model, D=D, verbose=False)
 
 
 def test_newton_rejects_wrong_length_vectors(square):
     _, b = square
-    model = Hyperelastic(b, mat.NeoHooke(1.0, 1.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=1.0, mu=1.0))
     with pytest.raises(ValueError, match="f_ext"):
         pg.solvers.newton(model, f_ext=np.zeros(b.N + 1), verbose=False)
 

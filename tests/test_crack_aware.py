@@ -284,7 +284,7 @@ def test_crack_aware_refuses_what_it_cannot_do():
     with pytest.raises(ValueError, match="mesh' family rule"):
         CrackAware(pg.FamilyBasis(mesh, dim=2, families="nearest"), STEEL)
     with pytest.raises(ValueError, match="no damage law"):
-        CrackAware(pg.FamilyBasis(mesh, dim=2), NeoHooke(1.0, 2.0))
+        CrackAware(pg.FamilyBasis(mesh, dim=2), NeoHooke(lam=1.0, mu=2.0))
     with pytest.raises(ValueError, match="no damage law"):
         CrackAware(pg.FamilyBasis(mesh, dim=2),
                    J2Plasticity.from_young(1.0, 0.3, 0.01))

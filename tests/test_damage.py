@@ -187,11 +187,11 @@ def test_laws_refuse_what_they_cannot_do():
     with pytest.raises(ValueError, match="Dc"):
         JohnsonCookDamage(0.05, 3.44, -2.12, 0.0)
     with pytest.raises(TypeError, match="either"):
-        J2Plasticity(1.0, 1.0, 0.5, hardening=JC)
+        J2Plasticity(mu=1.0, K=1.0, sigma_y0=0.5, hardening=JC)
     with pytest.raises(TypeError, match="not a damage law"):
-        J2Plasticity(1.0, 1.0, 0.5, damage=JC)
+        J2Plasticity(mu=1.0, K=1.0, sigma_y0=0.5, damage=JC)
     with pytest.raises(NotImplementedError, match="UnlP0"):
-        J2Plasticity(1.0, 1.0, 0.5, damage=JC_DAMAGE).isochoric()
+        J2Plasticity(mu=1.0, K=1.0, sigma_y0=0.5, damage=JC_DAMAGE).isochoric()
 
 
 def test_the_docstring_examples_run():
@@ -256,7 +256,7 @@ def test_formulations_carry_damage_and_the_mixed_ones_refuse_it():
     ppg = pg.FamilyBasis(mesh, dim=2, method="PPG1")
     with pytest.raises(NotImplementedError, match="MeanDilatation"):
         model_for("UnlP0", ppg, steel)
-    incompressible = J2Plasticity(steel.mu, np.inf, hardening=JC,
+    incompressible = J2Plasticity(mu=steel.mu, K=np.inf, hardening=JC,
                                   damage=JC_DAMAGE)
     with pytest.raises(NotImplementedError, match="MeanDilatation"):
         model_for("IUnlP0", basis, incompressible)

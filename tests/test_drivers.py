@@ -27,7 +27,7 @@ def beam():
 
 def test_record_and_keywords_are_the_same_run(beam):
     b, f, D = beam
-    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
     c = NewtonControls(steps=2, tol=1e-11, predictor=False, verbose=False)
     x1, h1 = newton(model, f, D=D, controls=c)
     x2, h2 = newton(model, f, D=D, steps=2, tol=1e-11, predictor=False,
@@ -82,7 +82,7 @@ def test_the_linear_algebra_is_injected(beam):
     the distributed Newton does with PETSc's): the same answer as newton,
     and every solve went through the injected object."""
     b, f, D = beam
-    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
     x_ref, _ = newton(model, f, D=D, steps=2, verbose=False)
     Dd = np.asarray(D.flatten())
     I = np.setdiff1d(np.arange(b.N), Dd)
@@ -109,7 +109,7 @@ def test_the_linear_algebra_is_injected(beam):
 
 def test_dynamics_take_their_records(beam):
     b, f, D = beam
-    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
     m = lumped_mass(b, 1.0)
     a = newmark(model, m, 0.2, 0.05, f_ext=f, D=D,
                 controls=NewmarkControls(output_every=2, verbose=False))
@@ -128,7 +128,7 @@ def test_drivers_name_what_a_model_lacks(beam):
     """The drivers take a model by its protocol (issue 49: no
     ``getattr(model, "N", basis.N)`` fallbacks): an object without ``N``
     is refused where it enters, naming the driver and the member."""
-    model = Hyperelastic(beam[0], mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(beam[0], mat.NeoHooke(lam=100.0, mu=40.0))
 
     class NoN:
         def __getattr__(self, name):
@@ -151,7 +151,7 @@ def test_a_problem_is_the_same_run_as_the_keywords(beam):
     (pg.Problem); each driver gives the keyword run's numbers bit for bit,
     and a keyword beside a Problem is refused, naming it."""
     b, f, D = beam
-    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
     problem = pg.Problem(model, f_ext=f, D=D)
     sol = newton(problem, verbose=False)
     x, hist = newton(model, f, D=D, verbose=False)
@@ -183,7 +183,7 @@ def test_a_wall_serves_several_runs_unchanged():
         mesh = fem.MeshQuad.init_tensor(np.linspace(0, length, 5),
                                         np.linspace(0, 1, 2))
         b = pg.FamilyBasis(mesh, dim=2)
-        model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+        model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
         v0 = np.where(np.arange(b.N) % 2 == 0, -0.1, 0.0)
         central_difference(model, lumped_mass(b, 1.0), 0.01, v0=v0,
                            wall=wall, verbose=False)

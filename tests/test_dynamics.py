@@ -15,7 +15,7 @@ from skfem_pg.solvers import (DynamicsError, RigidWall, central_difference,
 
 E, RHO = 100.0, 1.0
 C = np.sqrt(E / RHO)  # nu = 0: the bar's wave speed in plane strain
-ELASTIC = LinearElastic(0.0, E / 2)
+ELASTIC = LinearElastic(lam=0.0, mu=E / 2)
 
 
 def bar(L=10.0, nx=20, ny=2, H=1.0):
@@ -225,7 +225,7 @@ def test_explicit_refuses_global_mixed_fields():
     mesh = bar()
     basis = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2,
                            shape="WTE2")
-    model = model_for("U2P1C", basis, NeoHookeIsoVol(40.0, 100.0))
+    model = model_for("U2P1C", basis, NeoHookeIsoVol(mu=40.0, K=100.0))
     with pytest.raises(ValueError, match="newmark"):
         central_difference(model, lumped_mass(basis, 1.0), 1.0,
                            verbose=False)
@@ -324,13 +324,13 @@ def test_matrix_free_estimate_equals_the_assembled_one(formulation):
     default (its force is the cheap one); a Petrov–Galerkin model refuses
     it."""
     from skfem_pg.formulations import model_for
-    from skfem_pg.materials import J2Plasticity, lame
+    from skfem_pg.materials import J2Plasticity
     from skfem_pg.solvers.explicit import max_frequency
     mesh = pg.meshing.distort(fem.MeshQuad.init_tensor(
         np.linspace(0, 1, 9), np.linspace(0, 2, 17)), 0.2, seed=5)
     basis = pg.FamilyBasis(mesh, dim=2)
-    model = model_for(formulation, basis, J2Plasticity(*lame(1e3, 0.3),
-                                                       5.0))
+    model = model_for(formulation, basis, J2Plasticity.from_young(
+                                                       1e3, 0.3, 5.0))
     x = 0.003 * np.random.default_rng(1).standard_normal(basis.N)
     x += 0.1 * basis.doflocs[1] * (np.arange(basis.N) % 2)  # 10 % stretch
     model.commit(model.state(x))  # plastic history
@@ -342,6 +342,6 @@ def test_matrix_free_estimate_equals_the_assembled_one(formulation):
     assert getattr(model, "matrix_free_estimate", False) == (
         formulation == "U1SIG")
     ppg = Hyperelastic(pg.FamilyBasis(mesh, dim=2, method="PPG1"),
-                       J2Plasticity(*lame(1e3, 0.3), 5.0))
+                       J2Plasticity.from_young(1e3, 0.3, 5.0))
     with pytest.raises(ValueError, match="Petrov"):
         max_frequency(ppg, m, np.zeros(basis.N), matrix_free=True)

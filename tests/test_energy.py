@@ -25,7 +25,7 @@ def _bases(mesh):
 def test_linear_field_energy_is_captured_exactly(name):
     mesh = cube(4, 0.3, seed=2, kind="tet")
     b = _bases(mesh)[name]
-    m = mat.LinearElastic(LAM, MU)
+    m = mat.LinearElastic(lam=LAM, mu=MU)
     exact = m.energy(np.eye(3) + GRAD) * 1.0  # unit cube
     r = energy_capture(b, lambda x: np.tensordot(GRAD, x, 1), m, exact)
     assert abs(r - 1) < 1e-12
@@ -39,7 +39,7 @@ def test_discrete_energy_is_half_u_K_u(name):
     u = nodal_interpolant(b, lambda x: np.array(
         [np.sin(x[0] + x[2]), x[1] ** 2, np.cos(2 * x[0]) * x[1]]) * 1e-2)
     K = assemble(linear_elasticity(LAM, MU), b)
-    E = discrete_energy(b, u, mat.LinearElastic(LAM, MU))
+    E = discrete_energy(b, u, mat.LinearElastic(lam=LAM, mu=MU))
     assert E == pytest.approx(0.5 * u @ K @ u, rel=1e-12)
     assert E > 0
 
@@ -47,7 +47,7 @@ def test_discrete_energy_is_half_u_K_u(name):
 def test_bending_capture_separates_soft_and_stiff():
     """Pure bending of a unit cube: O1 locks (captures more than the
     exact energy), the interpolant on a fine regular set converges."""
-    m = mat.LinearElastic(LAM, MU)
+    m = mat.LinearElastic(lam=LAM, mu=MU)
     k = 1e-2
 
     def bend(x):

@@ -23,18 +23,18 @@ def test_everyday_names_at_the_top_level():
 
 def test_a_scene_names_missing_boundaries_at_construction(square):
     with pytest.raises(ValueError, match=r"'left', 'right'.*has none"):
-        pg.Scene("s", square, materials.NeoHooke(1.0, 1.0),
+        pg.Scene("s", square, materials.NeoHooke(lam=1.0, mu=1.0),
                  clamped=["left"], tractions={"right": [0.0, 1.0]})
     named = square.with_boundaries({"left": lambda x: x[0] == 0})
     with pytest.raises(ValueError, match=r"'right'.*the mesh has 'left'"):
-        pg.Scene("s", named, materials.NeoHooke(1.0, 1.0),
+        pg.Scene("s", named, materials.NeoHooke(lam=1.0, mu=1.0),
                  clamped=["left"], tractions={"right": [0.0, 1.0]})
 
 
 def test_result_prints_one_line(square):
     mesh = square.with_boundaries({"left": lambda x: x[0] == 0,
                                    "right": lambda x: x[0] == 1})
-    r = pg.Scene("s", mesh, materials.NeoHooke(1.0, 1.0), clamped=["left"],
+    r = pg.Scene("s", mesh, materials.NeoHooke(lam=1.0, mu=1.0), clamped=["left"],
                  tractions={"right": [0.0, 0.01]},
                  probes={"tip": (1.0, 1.0)}).solve("VCBCPBG V5m Unl")
     text = repr(r)
@@ -130,7 +130,7 @@ def test_one_verbosity_convention(square, capsys, monkeypatch):
     mesh = square.with_boundaries({"left": lambda x: x[0] == 0,
                                    "right": lambda x: x[0] == 1})
     b = pg.FamilyBasis(mesh, dim=2)
-    model = Hyperelastic(b, materials.NeoHooke(1.0, 1.0))
+    model = Hyperelastic(b, materials.NeoHooke(lam=1.0, mu=1.0))
     f = pg.traction(b, "right", [0.0, 0.01])
     pg.newton(model, f, D=b.get_dofs("left"))
     pg.newmark(model, pg.lumped_mass(b, 1.0), 0.2, 0.1, f_ext=f,
@@ -139,7 +139,7 @@ def test_one_verbosity_convention(square, capsys, monkeypatch):
     monkeypatch.setattr(progress, "AUTO_SECONDS", 0.0)
     pg.newton(model, f, D=b.get_dofs("left"), steps=2)
     assert capsys.readouterr().out.count("load ") == 2
-    pg.Scene("s", mesh, materials.NeoHooke(1.0, 1.0), clamped=["left"],
+    pg.Scene("s", mesh, materials.NeoHooke(lam=1.0, mu=1.0), clamped=["left"],
              tractions={"right": [0.0, 0.01]}).solve("VCBCPBG V5m Unl")
     assert "load 1.0000" in capsys.readouterr().out
     with pytest.raises(ValueError, match="verbose must be True, False or "

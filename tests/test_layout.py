@@ -75,7 +75,7 @@ def test_flat_coefficients_assemble_like_padded(basis):
     scikit-fem's generic assembly sees) give the same vectors and
     matrices."""
     d = basis.particles.dim
-    material = mat.NeoHookeIsoVol(1.0, 10.0)
+    material = mat.NeoHookeIsoVol(mu=1.0, K=10.0)
     u = 0.02 * np.random.default_rng(2).normal(size=basis.N)
     eye = np.eye(d).reshape(d, d, 1, 1)
     Fp = basis.interpolate(u).grad + eye
@@ -101,7 +101,7 @@ def test_flat_coefficients_assemble_like_padded(basis):
 
 def test_fd_tangent_on_flat_and_padded_state():
     basis = bases()[0]
-    material = mat.NeoHookeIsoVol(1.0, 10.0)
+    material = mat.NeoHookeIsoVol(mu=1.0, K=10.0)
     u = 0.02 * np.random.default_rng(3).normal(size=basis.N)
     eye = np.eye(3).reshape(3, 3, 1, 1)
     Kf = fd_tangent(basis, material, basis.interpolate(u, flat=True).grad

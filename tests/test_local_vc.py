@@ -85,7 +85,7 @@ def test_u1sig_on_a_local_vc_basis_corrects_its_u1_basis_locally():
     from skfem_pg.materials import NeoHooke
     mesh = square(6, 0.2, seed=3, kind="tri")
     b = pg.FamilyBasis(mesh, dim=2, vc_solver="local")  # MTE1, V5
-    u1 = U1SIG(b, NeoHooke(1.0, 1.0)).u1
+    u1 = U1SIG(b, NeoHooke(lam=1.0, mu=1.0)).u1
     assert u1 is not b and u1.shape == "WTE1"
     assert u1.vc_report.solver == "local"
     assert u1.vc_report.residual_after < 1e-10

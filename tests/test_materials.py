@@ -5,10 +5,10 @@ import pytest
 from skfem_pg import materials as mat
 
 MATERIALS = [
-    mat.LinearElastic(1.2, 0.8),
-    mat.LinearElastic(1.2, 0.8, plane_stress=True),
-    mat.StVenantKirchhoff(1.2, 0.8),
-    mat.NeoHooke(1.2, 0.8),
+    mat.LinearElastic(lam=1.2, mu=0.8),
+    mat.LinearElastic(lam=1.2, mu=0.8, plane_stress=True),
+    mat.StVenantKirchhoff(lam=1.2, mu=0.8),
+    mat.NeoHooke(lam=1.2, mu=0.8),
     mat.NeoHookeIsoVol.from_lame(1.2, 0.8),
 ]
 
@@ -61,6 +61,6 @@ def test_stress_free_reference_and_small_strain_limit(m):
     d = 3
     F = np.eye(d)[:, :, None] * np.ones(2)
     assert np.abs(m.stress(F)).max() < 1e-14
-    lin = mat.LinearElastic(1.2, 0.8)
+    lin = mat.LinearElastic(lam=1.2, mu=0.8)
     A0 = m.tangent(F)
     assert np.abs(A0 - lin.tangent(F)).max() < 1e-12

@@ -13,7 +13,7 @@ annulus = pg.meshing.annulus
 
 
 @pytest.mark.parametrize("model_of", [
-    lambda b: Hyperelastic(b, mat.NeoHooke(3.0, 1.0)),
+    lambda b: Hyperelastic(b, mat.NeoHooke(lam=3.0, mu=1.0)),
     lambda b: MeanDilatation(b, 1.0, 50.0),
 ], ids=["Q1 neo-Hooke", "Q1P0"])
 def test_tangent_is_derivative_of_internal_force(model_of):
@@ -50,7 +50,7 @@ def test_q1p0_reproduces_lame_cylinder_where_q1_locks():
     node = np.nonzero(np.isclose(mesh.p[0], a) & np.isclose(mesh.p[1], 0))[0]
     err = {}
     for name, model in (("Q1", Hyperelastic(basis,
-                                            mat.NeoHookeIsoVol(mu, K))),
+                                            mat.NeoHookeIsoVol(mu=mu, K=K))),
                         ("Q1P0", MeanDilatation(basis, mu, K))):
         u, _ = newton(model, f, D=D, verbose=False)
         err[name] = abs(u[2 * node[0]] - exact) / exact

@@ -147,7 +147,7 @@ def test_patch_test(name, incompressible):
         scene = Scene("patch", mesh, m, prescribed={"rest": path},
                       tractions={"right": P[:, 0]})
     else:
-        m = mat.NeoHookeIsoVol(1.0, 20.0)
+        m = mat.NeoHookeIsoVol(mu=1.0, K=20.0)
         J = np.linalg.det(F)
         p_exact = 0.5 * 20.0 * (J - 1 / J)
         scene = Scene("patch", mesh, m,
@@ -177,7 +177,7 @@ def test_free_block_has_exactly_the_rigid_body_zero_modes(name, formulation):
                                     np.linspace(0, 1, 6))
     basis = pg.FamilyBasis.from_name(mesh, name, dim=2)
     m = mat.NeoHookeIsoVol.incompressible(1.0) if formulation == "IUnlP0" \
-        else mat.NeoHookeIsoVol(1.0, 10.0)
+        else mat.NeoHookeIsoVol(mu=1.0, K=10.0)
     model = model_for(formulation, basis, m)
     K = model.tangent(model.state(model.initial()))
     ev = np.sort(np.abs(scipy.linalg.eigvalsh(K.toarray())))
@@ -195,7 +195,7 @@ def lame_cylinder(n, K, mu=1.0, p=1e-4, a=1.0, b=2.0):
         E = 2 * mu * (1 + nu)
         exact = (1 + nu) * p * a ** 2 / (E * (b ** 2 - a ** 2)) * \
             ((1 - 2 * nu) * a + b ** 2 / a)
-        m = mat.NeoHookeIsoVol(mu, K)
+        m = mat.NeoHookeIsoVol(mu=mu, K=K)
     else:
         exact = p * a * b ** 2 / (2 * mu * (b ** 2 - a ** 2))
         m = mat.NeoHookeIsoVol.incompressible(mu)
@@ -236,7 +236,7 @@ def test_mixed_names_build_their_models():
     mesh = square(3)
     p = pg.Particles.from_mesh(mesh)
     b = pg.FamilyBasis.from_name(p, "VCPBG UnlP0", dim=2)
-    m = mat.NeoHookeIsoVol(1.0, 10.0)
+    m = mat.NeoHookeIsoVol(mu=1.0, K=10.0)
     assert isinstance(model_for("UnlP0", b, m), MeanDilatation)
     assert isinstance(model_for("Unl", b, m), Hyperelastic)
     inc = mat.NeoHookeIsoVol.incompressible(1.0)
@@ -266,7 +266,7 @@ def test_ppg_unlp0_is_ppg_unl_on_homogeneous_deformations():
     the iso/vol neo-Hooke agree to round-off; otherwise they differ."""
     basis = pg.FamilyBasis(cube(3, 0.2, 1), dim=3, method="PPG1",
                            vc_boundary="sn")
-    m = mat.NeoHookeIsoVol(1.0, 50.0)
+    m = mat.NeoHookeIsoVol(mu=1.0, K=50.0)
     unlp0, unl = MasterDilatation.of(basis, m), Hyperelastic(basis, m)
     A = np.random.default_rng(1).standard_normal((3, 3)) * 0.05
     u = (A @ basis.doflocs)[np.arange(basis.N) % 3, np.arange(basis.N)]

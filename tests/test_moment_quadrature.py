@@ -197,7 +197,7 @@ def test_values_integrate_against_the_hat_functions():
     grad = np.array([[0.1, 0.3], [-0.2, 0.4]])
     u = (grad @ mesh.p).T.ravel()
     b = pg.FamilyBasis(mesh, dim=2, **MQ)
-    F = particle_fields(b, LinearElastic(LAM, MU), u)["F"]
+    F = particle_fields(b, LinearElastic(lam=LAM, mu=MU), u)["F"]
     assert np.abs(F.reshape(-1, 3, 3)[:, :2, :2] - np.eye(2)
                   - grad).max() < 1e-12
 
@@ -229,7 +229,7 @@ def test_refusals():
     from skfem_pg.formulations.updated_lagrange import UpdatedLagrange
     with pytest.raises(NotImplementedError, match="UL with family_quad"):
         UpdatedLagrange(pg.FamilyBasis(mesh, dim=2, **MQ),
-                        LinearElastic(LAM, MU))
+                        LinearElastic(lam=LAM, mu=MU))
     p = pg.Particles.from_mesh(mesh)
     with pytest.raises(ValueError, match="mesh's vertices"):
         pg.FamilyBasis(pg.Particles(p.x, p.volumes), dim=2, vc=None,
@@ -266,4 +266,4 @@ def test_mixed_formulations_see_the_points():
         assert np.allclose(X[:, g.flat], np.moveaxis(
             b.points[g.families, :g.m], -1, 0))
     with pytest.raises(NotImplementedError, match="members"):
-        model_for("U2P1C", b, NeoHookeIsoVol(30.0, 300.0))
+        model_for("U2P1C", b, NeoHookeIsoVol(mu=30.0, K=300.0))

@@ -114,7 +114,7 @@ def test_scene_solves_by_thesis_and_fe_names():
     m = fem.MeshQuad.init_tensor(np.linspace(0, 4, 9), np.linspace(0, 1, 3))
     m = m.with_boundaries({"left": lambda x: x[0] == 0,
                            "right": lambda x: x[0] == 4})
-    s = Scene("names", m, mat.NeoHooke(2.0, 1.0), clamped=["left"],
+    s = Scene("names", m, mat.NeoHooke(lam=2.0, mu=1.0), clamped=["left"],
               tractions={"right": [0.0, 0.01]}, probes={"tip": (4.0, 1.0)})
     a, b = s.solve("FEM Q1"), s.solve("Q1")
     assert a.method == "FEM Q1" and np.array_equal(a.u, b.u)
@@ -201,7 +201,7 @@ def test_a_formulation_of_ones_own_is_one_registration():
         mesh = _strip()
 
         def scene(t):
-            return Scene("own", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+            return Scene("own", mesh, NeoHooke(lam=10.0, mu=5.0), clamped=["left"],
                          tractions={"right": [0.0, t]},
                          probes={"tip": (4.0, 1.0)}, steps=2)
         kw, _ = parse("VCBCPBG V5m UnlX2")
@@ -210,7 +210,7 @@ def test_a_formulation_of_ones_own_is_one_registration():
         ref = scene(0.1).solve("VCBCPBG V5m Unl", tol=1e-12)
         assert np.abs(own.u - ref.u).max() <= 1e-9 * np.abs(ref.u).max()
         basis = own.basis
-        model = model_for("UnlX2", basis, NeoHooke(10.0, 5.0))
+        model = model_for("UnlX2", basis, NeoHooke(lam=10.0, mu=5.0))
         assert isinstance(model, Doubled)
         u, _ = pg.solvers.newton(model, own.f_ext, D=basis.get_dofs("left"),
                                  steps=2, tol=1e-12, verbose=False)
@@ -232,12 +232,12 @@ def test_a_registered_builder_must_return_a_model():
     import skfem as fem
     basis = pg.FamilyBasis(fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 4)]
                                                     * 2), dim=2)
-    assert isinstance(model_for("Unl", basis, NeoHooke(1.0, 1.0)), Model)
+    assert isinstance(model_for("Unl", basis, NeoHooke(lam=1.0, mu=1.0)), Model)
     pg.register_formulation("NotAModel", "MTE1", lambda b, m, t: object())
     try:
         with pytest.raises(TypeError, match="'NotAModel' built a object "
                            "without basis, n_u, N"):
-            model_for("NotAModel", basis, NeoHooke(1.0, 1.0))
+            model_for("NotAModel", basis, NeoHooke(lam=1.0, mu=1.0))
     finally:
         pg.registry.unregister("NotAModel")
 
@@ -254,7 +254,7 @@ def test_an_fe_comparator_of_ones_own_is_one_registration():
                             intorder=4)
     try:
         mesh = _strip()
-        sc = Scene("own-fe", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+        sc = Scene("own-fe", mesh, NeoHooke(lam=10.0, mu=5.0), clamped=["left"],
                    tractions={"right": [0.0, 0.1]},
                    probes={"tip": (4.0, 1.0)})
         g3, q1 = sc.solve("FEM Q1G3"), sc.solve("Q1")
@@ -299,7 +299,7 @@ def test_the_registry_routes_every_frame_and_reserves_fe_names():
                             updated_lagrangian=build_ul)
     try:
         mesh = _strip()
-        sc = Scene("own", mesh, NeoHooke(10.0, 5.0), clamped=["left"],
+        sc = Scene("own", mesh, NeoHooke(lam=10.0, mu=5.0), clamped=["left"],
                    tractions={"right": [0.0, 0.1]}, steps=2)
         basis, model, *_ = sc.setup("VCPBG V5m MyUL UL")
         assert built == [1] and isinstance(model, UpdatedLagrange)

@@ -88,7 +88,7 @@ def test_ppg1_newton_small_load_matches_linear_and_amg_gmres():
     b = pg.FamilyBasis(mesh, dim=2, method="PPG1")
     f = pg.traction(b, "right", [0.0, 1e-4])
     D = b.get_dofs("left").flatten()
-    model = Hyperelastic(b, mat.NeoHooke(100.0, 40.0))
+    model = Hyperelastic(b, mat.NeoHooke(lam=100.0, mu=40.0))
     u, hist = newton(model, f, D=D, verbose=False)
     K = pg.assemble(linear_elasticity(100.0, 40.0), b)
     ul = fem.solve(*fem.condense(K, f, D=D))

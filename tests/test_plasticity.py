@@ -56,7 +56,7 @@ def test_return_map_tangent_is_derivative_of_stress(d, state):
     r = m.update(F, h)
     if state == "elastic":
         assert not r.plastic.any()
-        e = NeoHookeIsoVol(m.mu, m.K)
+        e = NeoHookeIsoVol(mu=m.mu, K=m.K)
         assert np.abs(r.P - e.stress(F)).max() < 1e-12
     else:
         assert r.plastic.all()
@@ -217,9 +217,9 @@ def test_plastic_material_refuses_fd_tangent_and_bad_parameters():
     with pytest.raises(ValueError, match="history"):
         model_for("Unl", basis, STEEL, tangent="fd")
     with pytest.raises(ValueError, match="sigma_y0"):
-        J2Plasticity(1.0, 1.0, 0.0)
+        J2Plasticity(mu=1.0, K=1.0, sigma_y0=0.0)
     with pytest.raises(ValueError, match="soften"):
-        J2Plasticity(1.0, 1.0, 1.0, sigma_yinf=0.5)
+        J2Plasticity(mu=1.0, K=1.0, sigma_y0=1.0, sigma_yinf=0.5)
 
 
 def test_checkpoint_resumes_a_run(tmp_path):
@@ -291,7 +291,7 @@ def test_every_mixed_formulation_carries_plasticity(name, incompressible):
     nu = 0.5): plastic strain and force equal the single-point law along
     the same load steps."""
     m = STEEL if not incompressible else J2Plasticity(
-        STEEL.mu, np.inf, hardening=STEEL.hardening)
+        mu=STEEL.mu, K=np.inf, hardening=STEEL.hardening)
     mesh = fem.MeshQuad.init_tensor(*[np.linspace(0, 1, 6)] * 2)
     sc = Scene("plane strain tension", mesh.with_defaults(), m, steps=4,
                prescribed={"left": {0: 0.0}, "bottom": {1: 0.0},

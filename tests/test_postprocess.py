@@ -15,7 +15,7 @@ def test_homogeneous_stretch_gives_exact_fields(tmp_path):
     b = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
     Fh = np.array([[1.2, 0.1], [0.0, 0.9]])
     u = ((Fh - np.eye(2)) @ mesh.p).T.ravel()
-    m = mat.NeoHooke(100.0, 40.0)
+    m = mat.NeoHooke(lam=100.0, mu=40.0)
     out = particle_fields(b, m, u)
     F3 = np.eye(3)
     F3[:2, :2] = Fh
@@ -93,14 +93,14 @@ def test_small_strain_law_reports_its_own_stress():
     F = (np.eye(2) + H)[:, :, None]
     eps = 0.5 * (H + H.T)
     for plane_stress in (False, True):
-        m = mat.LinearElastic(100.0, 40.0, plane_stress=plane_stress)
+        m = mat.LinearElastic(lam=100.0, mu=40.0, plane_stress=plane_stress)
         sigma, vm = cauchy_and_von_mises(m, F)
         expected = np.zeros((3, 3))
         expected[:2, :2] = m.lam * np.trace(eps) * np.eye(2) + 2 * m.mu * eps
         expected[2, 2] = 0.0 if plane_stress else m.lam * np.trace(eps)
         assert np.abs(sigma[:, :, 0] - expected).max() < 1e-12
     # a finite-strain law is still pushed forward
-    nh = mat.NeoHooke(100.0, 40.0)
+    nh = mat.NeoHooke(lam=100.0, mu=40.0)
     F3 = np.eye(3)
     F3[:2, :2] += H
     sigma, _ = cauchy_and_von_mises(nh, F)
@@ -131,7 +131,7 @@ def _kirsch_hoop_errors(triangles, n, **basis_kwargs):
                                                          mu)
     K = pg.assemble(pg.formulations.linear_elasticity(lam, mu), b)
     u = fem.solve(*fem.condense(K, np.zeros(b.N), x=u, D=np.unique(D)))
-    s = particle_fields(b, mat.LinearElastic(lam, mu), u)["cauchy"]
+    s = particle_fields(b, mat.LinearElastic(lam=lam, mu=mu), u)["cauchy"]
     hole = np.nonzero(np.abs(np.hypot(*x) - 1) < 1e-9)[0]
     t = np.arctan2(x[1, hole], x[0, hole])
     hoop = (s[hole, 0] * np.sin(t) ** 2 + s[hole, 4] * np.cos(t) ** 2

@@ -20,7 +20,7 @@ def _mesh(loaded="right"):
 
 def _scene(mesh=None, mu=1.0, probe=(4.0, 1.0)):
     return Scene("cache-test", _mesh() if mesh is None else mesh,
-                 mat.NeoHooke(2.0, mu), clamped=["left"],
+                 mat.NeoHooke(lam=2.0, mu=mu), clamped=["left"],
                  tractions={"right": [0.0, 0.01]}, probes={"tip": probe})
 
 
@@ -76,7 +76,7 @@ def test_prescribed_components_of_quadratic_elements():
     mesh = _mesh().with_boundaries({"bottom": lambda x: x[1] == 0})
     # u_y = 0 on the bottom holds the y translation (without it the
     # system is singular and the solve refuses it)
-    s = Scene("sym", mesh, mat.NeoHooke(2.0, 1.0),
+    s = Scene("sym", mesh, mat.NeoHooke(lam=2.0, mu=1.0),
               prescribed={"left": {0: 0.0}, "right": {0: 0.05},
                           "bottom": {1: 0.0}})
     r = s.solve("Q2")

@@ -32,12 +32,12 @@ def rotated_stretch(x, t):
 
 
 @pytest.mark.parametrize("name, material", [
-    ("FEM Q1", mat.NeoHooke(2.0, 1.0)),
-    ("FEM T1", mat.NeoHooke(2.0, 1.0)),
-    ("FEM Q2", mat.NeoHooke(2.0, 1.0)),
-    ("FEM Q1P0", mat.NeoHookeIsoVol(1.0, 3.0)),
-    ("VCBCPBG V5m Unl", mat.NeoHooke(2.0, 1.0)),
-    ("VCBCPBG V5m UnlP0", mat.NeoHookeIsoVol(1.0, 3.0)),
+    ("FEM Q1", mat.NeoHooke(lam=2.0, mu=1.0)),
+    ("FEM T1", mat.NeoHooke(lam=2.0, mu=1.0)),
+    ("FEM Q2", mat.NeoHooke(lam=2.0, mu=1.0)),
+    ("FEM Q1P0", mat.NeoHookeIsoVol(mu=1.0, K=3.0)),
+    ("VCBCPBG V5m Unl", mat.NeoHooke(lam=2.0, mu=1.0)),
+    ("VCBCPBG V5m UnlP0", mat.NeoHookeIsoVol(mu=1.0, K=3.0)),
 ])
 def test_prescribed_rotation_and_reactions(name, material):
     """Every side follows a 90-degree rotation of a stretch: the solution
@@ -51,7 +51,7 @@ def test_prescribed_rotation_and_reactions(name, material):
     F = rotation(1.0) @ stretch(1.0)
     x = r.basis.doflocs[:, ::2]
     assert np.abs(r.u - ((F - np.eye(2)) @ x).T.ravel()).max() < 1e-10
-    P = mat.NeoHookeIsoVol(material.mu, material.K).stress(F) \
+    P = mat.NeoHookeIsoVol(mu=material.mu, K=material.K).stress(F) \
         if isinstance(material, mat.NeoHookeIsoVol) else material.stress(F)
     for side, expected in (("right", P[:, 0]), ("left", -P[:, 0]),
                            ("top", P[:, 1]), ("bottom", -P[:, 1])):
@@ -69,7 +69,7 @@ def test_callable_traction_and_its_reaction(name):
     here, measured; skfem_pg.discretization.loads)."""
     mesh = unit_square(6)
     s = 0.05
-    scene = Scene("traction", mesh, mat.NeoHooke(2.0, 1.0),
+    scene = Scene("traction", mesh, mat.NeoHooke(lam=2.0, mu=1.0),
                   clamped=["left"],
                   tractions={"right": lambda x: np.stack(
                       [0 * x[0], s * x[1]])})
@@ -84,7 +84,7 @@ def test_callable_traction_and_its_reaction(name):
 
 
 def test_prescribed_function_must_return_its_shape():
-    scene = Scene("bad", unit_square(2), mat.NeoHooke(2.0, 1.0),
+    scene = Scene("bad", unit_square(2), mat.NeoHooke(lam=2.0, mu=1.0),
                   prescribed={"left": lambda x, t: t * x[0]})
     with pytest.raises(ValueError, match="shape"):
         scene.solve("FEM Q1")
@@ -92,11 +92,11 @@ def test_prescribed_function_must_return_its_shape():
 
 def test_callables_enter_the_cache_key_by_content():
     m = unit_square(2)
-    a = Scene("k", m, mat.NeoHooke(2.0, 1.0),
+    a = Scene("k", m, mat.NeoHooke(lam=2.0, mu=1.0),
               prescribed={"left": rotated_stretch})
-    b = Scene("k", m, mat.NeoHooke(2.0, 1.0),
+    b = Scene("k", m, mat.NeoHooke(lam=2.0, mu=1.0),
               prescribed={"left": rotated_stretch})
-    c = Scene("k", m, mat.NeoHooke(2.0, 1.0),
+    c = Scene("k", m, mat.NeoHooke(lam=2.0, mu=1.0),
               prescribed={"left": lambda x, t: 0 * x})
     assert a.fingerprint() == b.fingerprint() != c.fingerprint()
 
@@ -120,7 +120,7 @@ def test_sliding_boundaries_pass_the_patch_test_or_are_refused(dim):
     rollers = {"x0": {0: 0.0}, "bottom": {dim - 1: 0.0}}
     if dim == 3:  # a second symmetry plane holds the y translation
         rollers["y0"] = {1: 0.0}
-    scene = Scene("rollers", mesh, mat.LinearElastic(1.0, 1.0),
+    scene = Scene("rollers", mesh, mat.LinearElastic(lam=1.0, mu=1.0),
                   prescribed=rollers, tractions={"top": t})
     for name in ("VCBCPBG V5m Unl", "VCBCPBG V5p Unl"):
         u = scene.solve(name).u.reshape(-1, dim).T
@@ -163,10 +163,10 @@ def test_cache_keys_see_every_parameter_to_the_last_bit():
     def key(A=792.0, D1=0.05, sy=None, tol=1e-9):
         if sy is None:
             law = J2Plasticity(
-                80.0, 160.0, hardening=JohnsonCookHardening(A, 510.0, 0.26),
+                mu=80.0, K=160.0, hardening=JohnsonCookHardening(A, 510.0, 0.26),
                 damage=JohnsonCookDamage(D1, 3.44, -2.12, 1.0))
         else:
-            law = J2Plasticity(80.0, 160.0, sy, H=0.13)
+            law = J2Plasticity(mu=80.0, K=160.0, sigma_y0=sy, H=0.13)
         sc = Scene("law", mesh, law, clamped=["left"],
                    prescribed={"right": {0: 0.01}})
         return sc.fingerprint(2, "Q2", exact({"tol": tol}))
@@ -179,9 +179,9 @@ def test_cache_keys_see_every_parameter_to_the_last_bit():
     assert key(sy=0.45) == key(sy=0.45) != key(sy=np.nextafter(0.45, 1.0))
     # a law's private caches (state of its last evaluation) are not
     # parameters: a used law keys like a fresh one
-    used = J2Plasticity(80.0, 160.0, 0.45, H=0.13)
+    used = J2Plasticity(mu=80.0, K=160.0, sigma_y0=0.45, H=0.13)
     used._spectral = np.ones((4, 3))
-    assert exact(used) == exact(J2Plasticity(80.0, 160.0, 0.45, H=0.13))
+    assert exact(used) == exact(J2Plasticity(mu=80.0, K=160.0, sigma_y0=0.45, H=0.13))
     import doctest
     from skfem_pg import keys
     result = doctest.testmod(keys)
@@ -194,7 +194,7 @@ def test_conflicting_or_impossible_conditions_are_named(scheme):
     winning, without a word; two boundaries that share a corner with
     different values likewise; a component out of range died in an
     IndexError."""
-    law = mat.NeoHooke(10.0, 4.0)
+    law = mat.NeoHooke(lam=10.0, mu=4.0)
     sq = unit_square()
     sc = Scene("both", sq, law, clamped=["right"],
                prescribed={"right": {0: 0.1}})

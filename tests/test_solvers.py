@@ -26,7 +26,7 @@ def test_small_load_matches_linear_solution(beam):
     mesh, b = beam
     f = pg.traction(b, "right", [0.0, 1e-4])
     D = b.get_dofs("left")
-    u, hist = newton(Hyperelastic(b, mat.NeoHooke(LAM, MU)), f, D=D,
+    u, hist = newton(Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU)), f, D=D,
                      verbose=False)
     ul = fem.solve(*fem.condense(pg.assemble(linear_elasticity(LAM, MU), b),
                                  f, D=D))
@@ -36,7 +36,7 @@ def test_small_load_matches_linear_solution(beam):
 def test_newton_converges_quadratically(beam):
     mesh, b = beam
     f = pg.traction(b, "right", [0.0, 0.5])
-    u, hist = newton(Hyperelastic(b, mat.NeoHooke(LAM, MU)), f,
+    u, hist = newton(Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU)), f,
                      D=b.get_dofs("left"),
                      tol=1e-12, verbose=False)
     r = np.array(hist[-1]["residuals"])
@@ -52,7 +52,7 @@ def test_newton_converges_quadratically(beam):
 def test_step_is_cut_when_J_becomes_negative(beam):
     mesh, b = beam
     f = pg.traction(b, "right", [0.0, 2.0])
-    u, hist = newton(Hyperelastic(b, mat.NeoHooke(LAM, MU)), f,
+    u, hist = newton(Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU)), f,
                      D=b.get_dofs("left"),
                      steps=1, verbose=False)
     assert len(hist) >= 2 and hist[-1]["load"] == 1.0
@@ -66,7 +66,7 @@ def test_impossible_compression_reports_the_load_factor(beam):
     right = b.get_dofs("right").nodal["u^1"]
     u_D[right] = -5.0  # squeeze a bar of length 4 by 5
     with pytest.raises(ConvergenceError, match="load factor") as err:
-        newton(Hyperelastic(b, mat.NeoHooke(LAM, MU)), D=D, u_D=u_D, steps=2,
+        newton(Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU)), D=D, u_D=u_D, steps=2,
                min_step=1 / 16, verbose=False)
     # the last converged state is reported: a bar of length 4 cannot be
     # squeezed by more than 4
@@ -81,7 +81,7 @@ def test_same_newton_on_scikit_fem_q1(beam):
                         facets="right")
     f = fem.LinearForm(lambda v, w: 1e-4 * v[1]).assemble(fb)
     D = fe.get_dofs("left")
-    u, _ = newton(Hyperelastic(fe, mat.NeoHooke(LAM, MU)), f, D=D,
+    u, _ = newton(Hyperelastic(fe, mat.NeoHooke(lam=LAM, mu=MU)), f, D=D,
                   verbose=False)
     ul = fem.solve(*fem.condense(linear_elasticity(LAM, MU).assemble(fe), f,
                                  D=D))
@@ -180,7 +180,7 @@ def test_fd_tangent_matches_consistent_tangent(beam):
     rng = np.random.default_rng(2)
     u = 0.02 * rng.standard_normal(b.N)
     F = b.interpolate(u).grad + np.eye(2)[:, :, None, None]
-    m = mat.NeoHooke(LAM, MU)
+    m = mat.NeoHooke(lam=LAM, mu=MU)
     K = pg.assemble(material_tangent, b, A=m.tangent(F))
     Kfd = fd_tangent(b, m, F)
     assert abs(K - Kfd).max() <= 1e-6 * abs(K).max()
@@ -196,7 +196,7 @@ def test_fixed_steps_neither_grow_nor_cut(beam):
     """adaptive=False: exactly ``steps`` equal steps (no doubling after an
     easy step), and a failing step raises at once (no halving)."""
     mesh, b = beam
-    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    model = Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU))
     f = pg.traction(b, "right", [0.0, 0.05])
     D = b.get_dofs("left")
     _, hist = newton(model, f, D=D, steps=4, adaptive=False, verbose=False)
@@ -223,7 +223,7 @@ def test_nearly_incompressible_small_load_converges_at_the_round_off_floor():
     f = fem.asm(fem.LinearForm(lambda v, w: load / 16 * v[1]),
                 basis.boundary("right"))
     D = basis.get_dofs("left").all()
-    model = Hyperelastic(basis, mat.NeoHookeIsoVol(G, LAM_ + 2 * G / 3))
+    model = Hyperelastic(basis, mat.NeoHookeIsoVol(mu=G, K=LAM_ + 2 * G / 3))
     u, hist = newton(model, f, D=D, verbose=False)
     assert len(hist) == 1  # no cut step
     assert hist[0]["reason"] == "round-off floor"
@@ -273,7 +273,7 @@ def test_a_failed_step_is_never_retried_unchanged(beam, monkeypatch):
     the same step again)."""
     from skfem_pg.solvers import static
     mesh, b = beam
-    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    model = Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU))
     tried, done = [], [0.0]  # (from, to, converged), last converged load
     step = static.newton_step
 
@@ -302,7 +302,7 @@ def test_amg_on_sliding_boundaries_and_the_step_callback():
     from skfem_pg.scenes import Scene
     from skfem_pg.solvers import rigid_body_modes
     mesh = fem.MeshHex.init_tensor(*[np.linspace(0, 1, 5)] * 3)
-    sc = Scene("sym", mesh.with_defaults(), mat.NeoHookeIsoVol(1.0, 3.0),
+    sc = Scene("sym", mesh.with_defaults(), mat.NeoHookeIsoVol(mu=1.0, K=3.0),
                prescribed={"left": {0: 0.0}, "bottom": {1: 0.0},
                            "front": {2: 0.0}, "right": {0: 0.1}})
     basis, model, f, D, u_D, _ = sc.setup("H1")
@@ -414,8 +414,8 @@ def test_pardiso_nearly_incompressible_newton_equals_superlu(name, nu,
     from skfem_pg.solvers import linear
     e = 4.8293
     material = (mat.NeoHookeIsoVol.incompressible(e / 3.0) if nu == 0.5
-                else mat.NeoHookeIsoVol(e / (2 * (1 + nu)),
-                                        e / (3 * (1 - 2 * nu))))
+                else mat.NeoHookeIsoVol(mu=e / (2 * (1 + nu)),
+                                        K=e / (3 * (1 - 2 * nu))))
     mesh = fem.MeshHex.init_tensor(np.linspace(0, 0.1, 5),
                                    np.linspace(0, 0.1, 5),
                                    np.linspace(0, 0.05, 3)).with_boundaries({
@@ -448,7 +448,7 @@ def test_modified_newton_equals_full_newton(beam, solver):
     if solver == "superlu":  # the scipy path of the kept factorization
         lin.factorize = lambda A: Factorization(A, "rcm+mmd")
     kw = dict(D=D, steps=4, tol=1e-12, verbose=False, solver=lin)
-    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    model = Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU))
     u, hist = newton(model, f, **kw)
     v, kept = newton(model, f, reuse=True, **kw)
     assert np.abs(v - u).max() <= 1e-10 * np.abs(u).max()
@@ -475,7 +475,7 @@ def test_modified_newton_without_kept_factors_is_newton(beam):
     mesh, b = beam
     f = pg.traction(b, "right", [0.0, -0.01])
     D = b.get_dofs("left")
-    model = Hyperelastic(b, mat.NeoHooke(LAM, MU))
+    model = Hyperelastic(b, mat.NeoHooke(lam=LAM, mu=MU))
     u, hist = newton(model, f, D=D, verbose=False,
                      solver=lambda A, r: pg.solvers.direct(A, r))
     v, kept = newton(model, f, D=D, verbose=False, reuse=True,

@@ -80,7 +80,7 @@ def test_frozen_plasticity_is_the_elastic_law_at_a_plastic_state(d):
     assert h["alpha"].min() > 0
     F = F0 + 1e-4 * rng.uniform(-1, 1, (d, d, n))
     frozen = FrozenPlasticity(STEEL.mu, STEEL.K, h["Cp_inv"])
-    elastic = J2Plasticity(STEEL.mu, STEEL.K, 1e9).update(F, h)
+    elastic = J2Plasticity(mu=STEEL.mu, K=STEEL.K, sigma_y0=1e9).update(F, h)
     assert np.abs(frozen.stress(F) - elastic.P).max() < 1e-12
     assert np.abs(frozen.tangent(F) - elastic.tangent()).max() < 1e-9
     assert np.abs(frozen.energy(F) - elastic.energy()).max() < 1e-12
@@ -151,7 +151,7 @@ def test_patch_test(formulation):
     p = pg.Particles.from_mesh(mesh)
     b = pg.FamilyBasis.from_name(p, "VCPBG V5m Unl", dim=2)
     model = {"U1SUnl": U1SUnl, "U1SIG": U1SIG}[formulation](
-        b, NeoHookeIsoVol(1.0, 5.0))
+        b, NeoHookeIsoVol(mu=1.0, K=5.0))
     B = np.array([[0.02, 0.01], [-0.03, 0.015]])
     u = (B @ p.x).T.ravel()
     f = model.internal_force(model.state(u)).reshape(-1, 2)
@@ -159,7 +159,7 @@ def test_patch_test(formulation):
     assert np.abs(f[inner]).max() < 1e-12
     # the boundary forces are the exact tractions: P . A^i
     F = np.eye(2) + B
-    P = NeoHookeIsoVol(1.0, 5.0).stress(F[:, :, None])[:, :, 0]
+    P = NeoHookeIsoVol(mu=1.0, K=5.0).stress(F[:, :, None])[:, :, 0]
     A = p.area_vectors()
     assert np.abs(f - (P @ A).T).max() < 1e-12
 
@@ -170,7 +170,7 @@ def test_elastic_u1sunl_is_unl():
     mesh = square(4, 0.3, seed=5)
     b = pg.FamilyBasis.from_name(pg.Particles.from_mesh(mesh),
                                  "VCPBG V5m Unl", dim=2)
-    m = NeoHookeIsoVol(1.0, 3.0)
+    m = NeoHookeIsoVol(mu=1.0, K=3.0)
     u = 0.05 * np.random.default_rng(0).uniform(-1, 1, b.N)
     s, unl = U1SUnl(b, m), Hyperelastic(b, m)
     f1, f2 = s.internal_force(s.state(u)), unl.internal_force(unl.state(u))
@@ -189,7 +189,7 @@ def test_tangent_is_derivative_of_force(formulation, plastic):
     mesh = square(4, 0.2, seed=6)
     b = pg.FamilyBasis.from_name(pg.Particles.from_mesh(mesh),
                                  "VCPBG V5m Unl", dim=2)
-    material = STEEL if plastic else NeoHookeIsoVol(80.0, 160.0)
+    material = STEEL if plastic else NeoHookeIsoVol(mu=80.0, K=160.0)
     model = {"U1SUnl": U1SUnl, "U1SIG": U1SIG}[formulation](b, material)
     rng = np.random.default_rng(1)
     u0 = 0.02 * rng.uniform(-1, 1, b.N)
@@ -223,12 +223,12 @@ def test_names_and_refusals():
     with pytest.raises(ValueError, match="bond"):
         pg.FamilyBasis.from_name(p, "VCBCPBG U1SIG", dim=2)
     with pytest.raises(ValueError, match="MTE1"):
-        U1SUnl(sig, NeoHookeIsoVol(1.0, 3.0))
+        U1SUnl(sig, NeoHookeIsoVol(mu=1.0, K=3.0))
     with pytest.raises(ValueError, match="finite bulk"):
         U1SIG(sig, NeoHookeIsoVol.incompressible(1.0))
     ppg = pg.FamilyBasis.from_name(p, "VCPPG Unl", dim=2)
     with pytest.raises(ValueError, match="PBG"):
-        U1SIG(ppg, NeoHookeIsoVol(1.0, 3.0))
+        U1SIG(ppg, NeoHookeIsoVol(mu=1.0, K=3.0))
 
 
 def test_necking_bar_mesh():
@@ -279,7 +279,7 @@ def test_ppg_unlp0_refused_where_unstable():
     from skfem_pg.scenes import Scene
     mesh = cube(4).with_boundaries({"a": lambda x: x[0] < 1e-9,
                                     "b": lambda x: x[0] > 1 - 1e-9})
-    sc = Scene("x", mesh, NeoHookeIsoVol(1.0, 2.0), clamped=["a", "b"])
+    sc = Scene("x", mesh, NeoHookeIsoVol(mu=1.0, K=2.0), clamped=["a", "b"])
     with pytest.raises(ValueError, match="unstable"):
         sc.setup("VCBCPPG V3m UnlP0")
     for name, unstable in (("VCBCPPG V3m UnlP0", True),

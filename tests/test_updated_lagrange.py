@@ -13,7 +13,7 @@ from skfem_pg.materials import J2Plasticity, NeoHooke
 from skfem_pg.naming import frame_of
 from skfem_pg.solvers import lumped_mass, newmark
 
-MATERIALS = {"neo-Hooke": NeoHooke(100.0, 40.0),
+MATERIALS = {"neo-Hooke": NeoHooke(lam=100.0, mu=40.0),
              "J2": J2Plasticity.from_young(100.0, 0.3, 0.5, H=1.0)}
 
 
@@ -97,7 +97,7 @@ def test_ul_by_name_and_dynamic_run_follows_tl():
                                  np.linspace(0, 1, 3)).with_boundaries(
         {"left": lambda x: np.isclose(x[0], 0.0),
          "right": lambda x: np.isclose(x[0], 10.0)})
-    sc = pg.scenes.Scene("beam", m, NeoHooke(100.0, 40.0),
+    sc = pg.scenes.Scene("beam", m, NeoHooke(lam=100.0, mu=40.0),
                          clamped=["left"])
     tips = {}
     for frame in ("TL", "UL"):
@@ -120,7 +120,7 @@ def test_a_rebuild_on_an_inverted_mesh_stops_the_run_with_its_time():
     DynamicsError at that time (not a stray ParticleError)."""
     from skfem_pg.solvers import DynamicsError
     sc = pg.scenes.Scene("cook", pg.meshing.cook_membrane(4),
-                         NeoHooke(121.0, 80.8), clamped=["left"])
+                         NeoHooke(lam=121.0, mu=80.8), clamped=["left"])
     basis, model, _, D, _, _ = sc.setup("PBG Unl UL noBC")
     f = pg.traction(basis, "right", [0.0, 1.0])
     with pytest.raises(DynamicsError, match="could not be committed") as e:

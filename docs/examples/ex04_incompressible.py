@@ -26,7 +26,7 @@ from skfem_pg.scenes import Scene
 from skfem_pg.scenes.reference import overkill
 
 MU = 0.375
-material = materials.NeoHookeIsoVol(MU, 1e4 * MU)
+material = materials.NeoHookeIsoVol(mu=MU, K=1e4 * MU)
 mesh = pg.meshing.cook_membrane(16, kind="quad")
 scene = Scene("cook-incompressible-ex04", mesh, material, clamped=["left"],
               tractions={"right": [0.0, 1.0 / 16]}, probes={"A": (48, 60)},

@@ -33,7 +33,7 @@ mesh = pg.meshing.distort(fem.MeshQuad.init_tensor(
     np.linspace(0, 48, 25), np.linspace(0, 12, 7)), 0.3, seed=5)
 mesh = mesh.with_boundaries({"left": lambda x: x[0] == 0,
                              "right": lambda x: x[0] == 48})
-material = materials.NeoHooke(100.0, 40.0)
+material = materials.NeoHooke(lam=100.0, mu=40.0)
 T_END, STEPS, RHO = 50.0, 200, 0.1
 tip = pg.meshing.vertex_at(mesh, (48.0, 6.0))
 fine = fem.MeshQuad.init_tensor(np.linspace(0, 48, 97),

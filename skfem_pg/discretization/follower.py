@@ -241,14 +241,18 @@ class FollowerPressure:
 
 
 def split_loads(f_ext):
-    """``(dead, followers)``: the dead load vectors (summed; ``None`` if
-    none) and the deformation-dependent loads (objects with ``force(u)``
-    and ``stiffness(u)``) of ``f_ext`` — an array, one such load, or a
-    list of both."""
-    items = f_ext if isinstance(f_ext, (list, tuple)) and any(
-        _follows(f) for f in f_ext) else [f_ext]
+    """``(dead, followers)``: the dead load (``f_ext`` itself when it holds
+    no deformation-dependent load: a vector, a callable of the time or
+    ``None``; the sum of the vectors of a list) and the
+    deformation-dependent loads (objects with ``force(u)`` and
+    ``stiffness(u)``) of ``f_ext`` — one such load or a list of both."""
+    if _follows(f_ext):
+        return None, [f_ext]
+    if not (isinstance(f_ext, (list, tuple))
+            and any(_follows(f) for f in f_ext)):
+        return f_ext, []
     dead, followers = None, []
-    for f in items:
+    for f in f_ext:
         if _follows(f):
             followers.append(f)
         elif f is not None:

@@ -112,7 +112,7 @@ class MeanDilatation(Hyperelastic):
                 "(the dilatation at the master, Theta^k = J^kk) is "
                 "MasterDilatation")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
+        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
         self.order = int(order)
         E = self.elements = Elements(basis)
         self.Phi = E.polynomials(self.order)

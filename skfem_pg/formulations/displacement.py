@@ -91,7 +91,7 @@ class Hyperelastic:
     >>> import numpy as np, skfem as fem, skfem_pg as pg
     >>> from skfem_pg.materials import NeoHooke
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
-    >>> model = Hyperelastic(basis, NeoHooke(60.0, 40.0))
+    >>> model = Hyperelastic(basis, NeoHooke(lam=60.0, mu=40.0))
     >>> state = model.state(np.zeros(model.N))
     >>> float(np.abs(model.internal_force(state)).max()), model.min_J(state)
     (0.0, 1.0)

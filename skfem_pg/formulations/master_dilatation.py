@@ -82,7 +82,7 @@ class MasterDilatation(Hyperelastic):
                 "whole necking bar)"
                 .format(basis.vc_boundary))
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
+        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
         p, fam = basis.particles, basis.families
         fam.require_every_master(p.x, "PPG UnlP0 / IUnlP0")
         mem, mask = fam.padded()

@@ -115,7 +115,7 @@ class WeakDirichlet:
     >>> mesh = mesh.with_boundaries({"left": lambda x: x[0] == 0})
     >>> basis = pg.FamilyBasis(mesh, dim=2, order=2)
     >>> model = WeakDirichlet(pg.formulations.Hyperelastic(
-    ...     basis, pg.materials.NeoHooke(1.0, 1.0)), {"left": None})
+    ...     basis, pg.materials.NeoHooke(lam=1.0, mu=1.0)), {"left": None})
     >>> model.N == basis.N, bool(model.load().any())  # a clamp: no load
     (True, False)
     """

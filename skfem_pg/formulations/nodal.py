@@ -114,7 +114,7 @@ class NodalPressure(Hyperelastic):
                 "family_quadrature='moments' the quadrature points are not "
                 "members: use the members (the default)")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu, K).K)  # checked
+        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
         self.bubble = bool(bubble)
         p = basis.particles
         self.n = p.n

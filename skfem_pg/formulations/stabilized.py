@@ -307,7 +307,7 @@ class U1SUnl(_MasterModel):
     >>> import numpy as np, skfem as fem, skfem_pg as pg
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
     >>> from skfem_pg.materials import NeoHooke
-    >>> model = U1SUnl(basis, NeoHooke(60.0, 40.0))
+    >>> model = U1SUnl(basis, NeoHooke(lam=60.0, mu=40.0))
     >>> state = model.state(np.zeros(model.N))
     >>> float(np.abs(model.internal_force(state)).max())
     0.0
@@ -386,7 +386,7 @@ class U1SIG(_MasterModel):
     >>> from skfem_pg.materials import NeoHooke
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2, shape="WTE1",
     ...                        bond=False)
-    >>> model = U1SIG(basis, NeoHooke(60.0, 40.0))
+    >>> model = U1SIG(basis, NeoHooke(lam=60.0, mu=40.0))
     >>> state = model.state(np.zeros(model.N))
     >>> float(np.abs(model.internal_force(state)).max())
     0.0

@@ -108,7 +108,7 @@ class UpdatedLagrange(Hyperelastic):
     >>> import numpy as np, skfem as fem, skfem_pg as pg
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
     >>> from skfem_pg.materials import NeoHooke
-    >>> model = UpdatedLagrange(basis, NeoHooke(60.0, 40.0), every=2)
+    >>> model = UpdatedLagrange(basis, NeoHooke(lam=60.0, mu=40.0), every=2)
     >>> model.N == basis.N, model.every
     (True, 2)
 

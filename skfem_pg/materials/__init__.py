@@ -8,9 +8,10 @@ from .hyperelastic import (Material, LinearElastic, StVenantKirchhoff,
 from .plasticity import J2Plasticity, ReturnMapError
 from .hardening import LinearSaturation, JohnsonCookHardening
 from .damage import CriticalStrainDamage, JohnsonCookDamage
+from .library import FElupeMaterial
 
 __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
            "inverse_and_det", "J2Plasticity", "ReturnMapError",
            "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage",
-           "CriticalStrainDamage"]
+           "CriticalStrainDamage", "FElupeMaterial"]

@@ -11,6 +11,8 @@ stretch is 1) except :class:`LinearElastic` with ``plane_stress=True``.
 Tangents are verified against central finite differences in
 ``tests/test_materials.py``.
 """
+import inspect
+
 import numpy as np
 
 from .constants import check_moduli
@@ -81,9 +83,27 @@ class Material:
 
     ``small_strain`` is true for a law whose ``stress`` is the small-strain
     stress itself (output reports it as the Cauchy stress, without the push
-    forward :math:`PF^T/J` of a finite-strain law)."""
+    forward :math:`PF^T/J` of a finite-strain law).
+
+    The package's laws take their moduli by name (``NeoHooke(lam=...,
+    mu=...)``, ``NeoHookeIsoVol(mu=..., K=...)``): two plain floats in
+    the order of another law's constructor were accepted silently.  A
+    positional call raises ``TypeError`` naming the keywords."""
 
     small_strain = False
+
+    def __new__(cls, *args, **kwargs):
+        if args:  # a law whose constructor takes names only
+            params = list(inspect.signature(cls.__init__).parameters.values())
+            names = [p.name for p in params if p.kind is p.KEYWORD_ONLY]
+            if any(p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD,
+                              p.VAR_POSITIONAL) for p in params[1:]):
+                return super().__new__(cls)
+            raise TypeError(
+                "{0} takes its moduli by name: {0}({1}) (got {2} positional "
+                "argument(s))".format(cls.__name__, ", ".join(
+                    "{}=...".format(n) for n in names[:3]), len(args)))
+        return super().__new__(cls)
 
     def stress(self, F):
         raise NotImplementedError
@@ -117,7 +137,7 @@ class LinearElastic(Material):
 
     small_strain = True
 
-    def __init__(self, lam, mu, plane_stress=False):
+    def __init__(self, *, lam, mu, plane_stress=False):
         lam, mu = check_moduli(lam=lam, mu=mu)
         self.plane_stress = bool(plane_stress)
         if plane_stress:
@@ -158,7 +178,7 @@ class StVenantKirchhoff(Material):
 
     """
 
-    def __init__(self, lam, mu):
+    def __init__(self, *, lam, mu):
         self.lam, self.mu = check_moduli(lam=lam, mu=mu)
 
     def _S(self, F):
@@ -205,7 +225,7 @@ class NeoHooke(Material):
 
     """
 
-    def __init__(self, lam, mu):
+    def __init__(self, *, lam, mu):
         self.lam, self.mu = check_moduli(lam=lam, mu=mu)
 
     def stress(self, F):
@@ -249,18 +269,18 @@ class NeoHookeIsoVol(Material):
 
     """
 
-    def __init__(self, mu, K):
+    def __init__(self, *, mu, K):
         self.mu, self.K = check_moduli(mu=mu, K=K)
 
     @classmethod
     def from_lame(cls, lam, mu):
-        return cls(mu, lam + 2.0 * mu / 3.0)
+        return cls(mu=mu, K=lam + 2.0 * mu / 3.0)
 
     @classmethod
     def isochoric(cls, mu):
         """The isochoric part alone (``K = 0``), e.g. for a mean-dilatation
         model that adds the volumetric part per element."""
-        m = cls(mu, 1.0)
+        m = cls(mu=mu, K=1.0)
         m.K = 0.0
         return m
 
@@ -269,7 +289,7 @@ class NeoHookeIsoVol(Material):
         r"""The incompressible limit (:math:`\nu = 0.5`, ``K = inf``): only
         the formulations with a pressure unknown (IUnlP0,
         :class:`~skfem_pg.formulations.IncompressibleP0`) accept it."""
-        m = cls(mu, 1.0)
+        m = cls(mu=mu, K=1.0)
         m.K = np.inf
         return m
 

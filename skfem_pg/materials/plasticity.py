@@ -135,7 +135,7 @@ class J2Plasticity(Material):
 
     stateful = True
 
-    def __init__(self, mu, K, sigma_y0=None, H=0.0, sigma_yinf=None,
+    def __init__(self, *, mu, K, sigma_y0=None, H=0.0, sigma_yinf=None,
                  delta=0.0, hardening=None, damage=None):
         if isinstance(K, (int, float, np.number)) and np.isposinf(K):
             # incompressible: the documented use of inf
@@ -171,7 +171,7 @@ class J2Plasticity(Material):
         """From Young's modulus and Poisson's ratio."""
         E, nu = check_moduli(E=E, nu=nu)
         mu = E / (2 * (1 + nu))
-        return cls(mu, E / (3 * (1 - 2 * nu)), sigma_y0, **kw)
+        return cls(mu=mu, K=E / (3 * (1 - 2 * nu)), sigma_y0=sigma_y0, **kw)
 
     def isochoric(self, with_damage=False):
         """The same law without the volumetric part (``K = 0``), for the
@@ -190,14 +190,14 @@ class J2Plasticity(Material):
                 "add the pressure per element or particle only PBG UnlP0 "
                 "and FE Q1P0/H1P0 (MeanDilatation) take it: use those, "
                 "Unl, U1SUnl, U1SIG or FE Q1/H1/T1/O1".format(self))
-        m = J2Plasticity(self.mu, 1.0, hardening=self.hardening,
+        m = J2Plasticity(mu=self.mu, K=1.0, hardening=self.hardening,
                          damage=self.damage)
         m.K = 0.0
         return m
 
     def elastic(self):
         """The elastic part alone, :class:`NeoHookeIsoVol` (2.46)."""
-        m = NeoHookeIsoVol(self.mu, 1.0)
+        m = NeoHookeIsoVol(mu=self.mu, K=1.0)
         m.K = self.K
         return m
 

@@ -114,7 +114,7 @@ class Scene:
     ...                                 np.linspace(0, 1, 3))
     >>> mesh = mesh.with_boundaries({"left": lambda x: x[0] == 0,
     ...                              "right": lambda x: x[0] == 4})
-    >>> sc = Scene("strip", mesh, NeoHooke(60.0, 40.0), clamped=["left"],
+    >>> sc = Scene("strip", mesh, NeoHooke(lam=60.0, mu=40.0), clamped=["left"],
     ...            tractions={"right": [1.0, 0.0]}, probes={"tip": (4.0, 1.0)})
     >>> pg_tip = sc.solve("PG", verbose=False).probes["tip"][0]
     >>> q1_tip = sc.solve("Q1", verbose=False).probes["tip"][0]
@@ -579,7 +579,7 @@ class Setup(NamedTuple):
     >>> from skfem_pg.materials import NeoHooke
     >>> mesh = fem.MeshQuad().refined(2).with_boundaries(
     ...     {"left": lambda x: x[0] == 0})
-    >>> setup = Scene("block", mesh, NeoHooke(60.0, 40.0),
+    >>> setup = Scene("block", mesh, NeoHooke(lam=60.0, mu=40.0),
     ...               clamped=["left"]).setup("PG")
     >>> basis, model, f_ext, D, u_D, seconds = setup  # unpacks as before
     >>> setup.problem.model is model, len(setup.D)

@@ -244,7 +244,7 @@ class Trajectory:
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
     >>> from skfem_pg.formulations import Hyperelastic
     >>> from skfem_pg.materials import NeoHooke
-    >>> problem = pg.Problem(Hyperelastic(basis, NeoHooke(60.0, 40.0)),
+    >>> problem = pg.Problem(Hyperelastic(basis, NeoHooke(lam=60.0, mu=40.0)),
     ...                      mass=pg.lumped_mass(basis, 1.0))
     >>> v0 = np.tile([0.1, 0.0], basis.N // 2)  # a rigid translation
     >>> tr = pg.central_difference(problem, t_end=0.01, v0=v0, verbose=False)

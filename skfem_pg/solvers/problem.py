@@ -19,7 +19,7 @@ records (:class:`Solution`, :class:`~skfem_pg.solvers.dynamics.Trajectory`).
 >>> basis = pg.FamilyBasis(mesh, dim=2)
 >>> f = np.zeros(basis.N)
 >>> f[basis.get_dofs(lambda x: x[0] == 4).nodal["u^2"]] = -0.02
->>> problem = pg.solvers.Problem(Hyperelastic(basis, NeoHooke(10.0, 4.0)),
+>>> problem = pg.solvers.Problem(Hyperelastic(basis, NeoHooke(lam=10.0, mu=4.0)),
 ...                              f_ext=f, D=basis.get_dofs(lambda x: x[0] == 0))
 >>> sol = pg.solvers.newton(problem, verbose=False)
 >>> sol.x.shape == (basis.N,), len(sol.history)
@@ -72,7 +72,7 @@ class Problem:
     >>> from skfem_pg.formulations import Hyperelastic
     >>> from skfem_pg.materials import NeoHooke
     >>> basis = pg.FamilyBasis(fem.MeshQuad().refined(2), dim=2)
-    >>> problem = Problem(Hyperelastic(basis, NeoHooke(60.0, 40.0)),
+    >>> problem = Problem(Hyperelastic(basis, NeoHooke(lam=60.0, mu=40.0)),
     ...                   D=basis.get_dofs(lambda x: x[0] == 0),
     ...                   walls=pg.solvers.RigidWall(1))
     >>> len(problem.walls), problem.replace(mass=pg.lumped_mass(

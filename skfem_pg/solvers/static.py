@@ -90,7 +90,7 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     model
         A :class:`~skfem_pg.solvers.problem.Problem` (the model with its
         ``f_ext``, ``D``, ``u_D``), or a :mod:`skfem_pg.formulations`
-        model, e.g. ``Hyperelastic(basis, NeoHooke(lam, mu))``, with the
+        model, e.g. ``Hyperelastic(basis, NeoHooke(lam=lam, mu=mu))``, with the
         keywords below.  Its unknowns ``x`` are the displacements
         (``model.n_u``, scikit-fem numbering of ``model.basis``) followed
         by its global extra fields, if any (``model.N`` in all).
@@ -158,7 +158,7 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     >>> mesh = fem.MeshQuad.init_tensor(np.linspace(0, 4, 9),
     ...                                  np.linspace(0, 1, 3))
     >>> basis = pg.FamilyBasis(pg.Particles.from_mesh(mesh), dim=2)
-    >>> model = Hyperelastic(basis, NeoHooke(10.0, 4.0))
+    >>> model = Hyperelastic(basis, NeoHooke(lam=10.0, mu=4.0))
     >>> D = basis.get_dofs(lambda x: x[0] == 0).all()
     >>> f = np.zeros(basis.N)
     >>> f[basis.get_dofs(lambda x: x[0] == 4).nodal["u^2"]] = -0.02
