@@ -3,6 +3,7 @@
 Every message names the culprit (particle index, position, family size) so a
 user can find it in ParaView or in the mesh file.
 """
+import warnings
 
 
 class ParticleError(ValueError):
@@ -33,6 +34,20 @@ class UnsupportedMeshError(TypeError):
 class SlowAssemblyWarning(UserWarning):
     """scikit-fem's generic assembly runs on a FamilyBasis: correct, but
     far slower than :func:`skfem_pg.assemble`."""
+
+
+def warn_slow_assembly(kind, nbfun, stacklevel=3):
+    """Warn (:class:`SlowAssemblyWarning`) that scikit-fem's generic
+    assembly on a ``kind`` basis calls a bilinear form once per pair of
+    its ``nbfun`` local functions."""
+    warnings.warn(
+        "scikit-fem's generic assembly on a {} calls the form once per "
+        "local basis function ({}) or, bilinear, per pair of them ({} "
+        "calls) and is far slower than skfem_pg.assemble; use "
+        "skfem_pg.BilinearForm / LinearForm as decorators (same forms, "
+        "fast path) or skfem_pg.assemble(form, basis)".format(
+            kind, nbfun, nbfun ** 2), SlowAssemblyWarning,
+        stacklevel=stacklevel)
 
 
 class SurfaceLoadWarning(UserWarning):

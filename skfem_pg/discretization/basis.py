@@ -52,7 +52,7 @@ from . import petrov
 from .builder import BasisSpec
 from .corrections import family_radii
 from ..dofs import as_dofs
-from ..errors import MixedBasisWarning, SlowAssemblyWarning
+from ..errors import MixedBasisWarning, warn_slow_assembly
 from .particles import Particles, linear_elements
 from .quadrature import volume_weights
 from ..threads import kernel
@@ -511,15 +511,7 @@ class FamilyBasis(AbstractBasis):
         (:class:`~skfem_pg.errors.SlowAssemblyWarning`)."""
         if self._generic_pending:
             self._generic_pending = False
-            warnings.warn(
-                "scikit-fem's generic assembly on a FamilyBasis calls the "
-                "form once per local basis function ({}) or, bilinear, per "
-                "pair of them ({} calls) and is 5-40x slower than "
-                "skfem_pg.assemble; use skfem_pg.BilinearForm / LinearForm "
-                "as decorators (same forms, fast path) or "
-                "skfem_pg.assemble(form, basis)".format(
-                    self.Nbfun, self.Nbfun ** 2), SlowAssemblyWarning,
-                stacklevel=2)
+            warn_slow_assembly("FamilyBasis", self.Nbfun)
         if self._basis is None:
             self._basis = [self._basis_function(ix)
                            for ix in range(self.Nbfun)]

@@ -44,7 +44,6 @@ the patch test), unlike the first-order :class:`FamilyBasis`.
 """
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from typing import NamedTuple
 
@@ -54,7 +53,7 @@ import skfem as fem
 from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
-from ..errors import FamilyError, SlowAssemblyWarning
+from ..errors import FamilyError, warn_slow_assembly
 from .particles import Particles, linear_elements
 from .shape.common import FamilyGeometry, chunks
 from .shape.quadratic import (taylor2_basis, taylor2_derivatives,
@@ -461,13 +460,7 @@ class BlendBasis(AbstractBasis):
         (made when asked for); a bilinear form there costs ``Nbfun**2``
         form calls, which :func:`skfem_pg.assemble` avoids."""
         if self.Nbfun ** 2 > 4000:
-            warnings.warn(
-                "scikit-fem's generic assembly on a BlendBasis calls a "
-                "bilinear form once per pair of its {} local functions ({} "
-                "calls); use skfem_pg.BilinearForm / LinearForm as "
-                "decorators or skfem_pg.assemble(form, basis)".format(
-                    self.Nbfun, self.Nbfun ** 2), SlowAssemblyWarning,
-                stacklevel=2)
+            warn_slow_assembly("BlendBasis", self.Nbfun)
         return _LazyFunctions(self)
 
     def default_parameters(self):

@@ -31,7 +31,6 @@ from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
-import skfem as fem
 from numpy.typing import ArrayLike
 
 __all__ = ["FollowerPressure", "split_loads"]
