@@ -230,24 +230,46 @@ def measure_script(command):
     return times
 
 
-def measure_tests(args):
-    """``{"seconds": s, "passed": n}`` of ``python -m pytest -q args`` in
-    the source tree."""
-    t0 = time.perf_counter()
-    # the check of the quoted times is left out: it fails until they are
-    # measured, i.e. while they are (a millisecond test)
+#: the checks of the quoted numbers, left out of the measured runs: they
+#: fail until the numbers are measured, i.e. while they are
+UNMEASURED = ["--deselect", "tests/test_harness.py::"
+              "test_quoted_times_are_the_measured_ones",
+              "--deselect", "tests/test_harness.py::"
+              "test_quoted_test_counts_are_of_the_current_suite"]
+
+
+def count_tests(args):
+    """How many tests ``python -m pytest args`` selects, without running
+    them, the MPI module left out (its collection depends on whether
+    mpi4py is installed): what identifies the suite a quoted count and
+    time are of."""
     done = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider",
-         "--deselect", "tests/test_harness.py::"
-         "test_quoted_times_are_the_measured_ones"]
-        + args, cwd=ROOT, capture_output=True, text=True)
+        [sys.executable, "-m", "pytest", "--collect-only", "-q", "-p",
+         "no:cacheprovider", "--ignore", "tests/test_distributed.py"]
+        + UNMEASURED + args, cwd=ROOT, capture_output=True, text=True)
+    found = re.findall(r"(\d+)(?:/\d+)? tests? collected", done.stdout)
+    if done.returncode not in (0, 5) or not found:
+        raise RuntimeError("pytest --collect-only {} failed: {}".format(
+            " ".join(args), done.stdout.strip()[-300:]))
+    return int(found[-1])
+
+
+def measure_tests(args):
+    """``{"seconds": s, "passed": n, "collected": m}`` of ``python -m
+    pytest -q args`` in the source tree (``collected``:
+    :func:`count_tests`)."""
+    t0 = time.perf_counter()
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider"]
+        + UNMEASURED + args, cwd=ROOT, capture_output=True, text=True)
     seconds = time.perf_counter() - t0
     last = done.stdout.strip().splitlines()[-1] if done.stdout else ""
     if done.returncode:
         raise RuntimeError("pytest {} failed: {}".format(" ".join(args),
                                                          last))
     passed = re.search(r"(\d+) passed", last)
-    return {"seconds": seconds, "passed": int(passed.group(1))}
+    return {"seconds": seconds, "passed": int(passed.group(1)),
+            "collected": count_tests(args)}
 
 
 def measure_decorators():

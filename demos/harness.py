@@ -12,6 +12,7 @@ A *row* is a dict with at least ``method``, ``err`` and the time split
 """
 import argparse
 import os
+import re
 import shutil
 import tempfile
 
@@ -52,7 +53,8 @@ def demo_parser(doc, results=False, quick=True):
     ``results``, ``--results`` (a markdown page whose section of this
     script :func:`update_results` rewrites)."""
     ap = argparse.ArgumentParser(
-        description=" ".join(doc.strip().split("\n\n")[0].split()),
+        description=plain_text(" ".join(doc.strip().split("\n\n")[0]
+                                        .split())),
         formatter_class=_ShowDefaults)
     ap.add_argument("--out", help="output directory (default: "
                     "$SKFEM_PG_OUT or ./out)")
@@ -66,6 +68,20 @@ def demo_parser(doc, results=False, quick=True):
                         "this script is rewritten (e.g. "
                         "benchmarks/README.md)")
     return ap
+
+
+def plain_text(text):
+    """``text`` without reST markup, for a terminal: roles
+    (``:func:`~a.b.c``` -> ``c``, ``:func:`a.b``` -> ``a.b``), literals
+    and emphasis.
+
+    >>> plain_text(":func:`~skfem_pg.newton` and ``--quick`` *now*")
+    'newton and --quick now'
+    """
+    text = re.sub(r":[\w:]+:`~[^`]*?([^.`]+)`", r"\1", text)
+    text = re.sub(r":[\w:]+:`([^`]+)`", r"\1", text)
+    text = re.sub(r"``([^`]+)``", r"\1", text)
+    return re.sub(r"(?<![\w*])\*([^*\s][^*]*)\*(?![\w*])", r"\1", text)
 
 
 def write_atomically(path, text):

@@ -47,6 +47,8 @@ sphinx_gallery_conf = {
     "matplotlib_animations": False,
     "reset_modules": ("matplotlib",),
     "write_computation_times": False,
+    # ex01, ex02, ... as numbered (the default orders by file length)
+    "within_subsection_order": "FileNameSortKey",
 }
 
 # the examples write their own figure too: keep it out of the source tree

@@ -64,6 +64,17 @@ class LoadCase(NamedTuple):
         under this load case (and ``f_ext``)."""
         return Problem(model, f_ext=f_ext, D=self.D, u_D=self.u_D)
 
+    def curve(self, label=None):
+        """A :class:`~skfem_pg.analysis.curves.Curve` of the reaction on
+        the moved dofs over their mean displacement, to pass to
+        :func:`~skfem_pg.solvers.newton` as its ``callback``."""
+        from .analysis.curves import Curve
+        moved = self.moved
+        return Curve(lambda u, load, f: np.mean(u[moved]),
+                     lambda u, load, f: f[moved].sum(),
+                     xlabel="displacement of the moved face",
+                     ylabel="reaction force", label=label)
+
     def reaction(self, model, x) -> float:
         """The force on the moved dofs at the unknowns ``x`` (the sum of
         the internal force there)."""

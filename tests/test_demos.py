@@ -171,7 +171,7 @@ def _torsion_dynamic(out):
 
 def _taylor(out):
     rows = _table_rows(out)
-    pg_, fe = rows["VCPBG Unl"], rows["FEM H1"]
+    pg_, fe = rows["VCPBG U1SIG"], rows["FEM H1P0"]  # the defaults
     assert pg_[-1] == fe[-1] == "done"
     for col, tol in ((0, 0.01), (1, 0.05)):  # length, mushroom radius
         a, b = (float(r[col].split()[0]) for r in (pg_, fe))

@@ -819,3 +819,28 @@ def test_condensed_mixed_newton_equals_serial(formulation, material):
         ep_s = ms.plastic_strain()[1]
         ep = max(COMM.allgather(md.plastic_strain()[1]))
         assert ep_s > 0 and abs(ep - ep_s) <= 1e-10 * ep_s
+
+
+def test_mpi_guide_blocks_run_on_the_ranks():
+    """The MPI guide's code blocks (docs/guide/mpi.md) run as written on
+    these ranks, each in a namespace of its own (tests/test_doc_blocks.py
+    runs the serial pages' blocks)."""
+    import os
+    import tempfile
+    from test_doc_blocks import MPI_PAGES, HAS_DOCS, blocks, run_doc_block
+    if not HAS_DOCS:
+        pytest.skip("needs the source tree's docs/")
+    root = COMM.bcast(tempfile.mkdtemp() if COMM.rank == 0 else None)
+    here = os.getcwd()
+    try:
+        os.chdir(root)
+        found = 0
+        for page in MPI_PAGES:
+            for line, code in blocks(page):
+                run_doc_block(code, "{}:{}".format(page, line))
+                found += 1
+        assert found == 2
+        COMM.Barrier()
+        assert os.path.isfile("u.pvtu")
+    finally:
+        os.chdir(here)

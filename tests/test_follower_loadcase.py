@@ -192,3 +192,28 @@ def test_scene_with_follower_pressure():
         follower.solve("PG2", verbose=False)
     with pytest.raises(NotImplementedError, match="linear vector elements"):
         follower.solve("Q2", verbose=False)
+
+
+def test_load_case_curve_records_the_steps_and_plots():
+    """The reaction–displacement curve of a uniaxial stretch, PG: the
+    origin and one point per load step, the last the reaction at the end,
+    increasing; its plot draws those points."""
+    import matplotlib
+    matplotlib.use("Agg")
+    mesh = _meshes()[0]
+    basis = pg.FamilyBasis(mesh, dim=2)
+    model = Hyperelastic(basis, NeoHooke(lam=LAM, mu=MU))
+    case = loadcase.uniaxial(basis, move=0.2)
+    curve = case.curve(label="PG")
+    x, _ = pg.solvers.newton(case.problem(model), steps=4, adaptive=False,
+                             callback=curve, verbose=False)
+    assert len(curve) == 5 and np.allclose(curve.load, [0, .25, .5, .75, 1])
+    assert curve.y[-1] == pytest.approx(case.reaction(model, x), rel=1e-12)
+    assert curve.x[-1] == pytest.approx(0.2, rel=1e-12)
+    assert np.all(np.diff(curve.y) > 0)
+    ax = curve.plot()
+    line, = ax.get_lines()
+    assert np.array_equal(line.get_ydata(), curve.y)
+    assert "reaction" in ax.get_ylabel() and "5 points" in repr(curve)
+    with pytest.raises(TypeError, match="callables"):
+        pg.analysis.Curve(1.0, 2.0)

@@ -119,6 +119,26 @@ def test_quoted_times_are_the_measured_ones():
                 assert "{}/{}".format(folder, name) in scripts, name
 
 
+def test_quoted_test_counts_are_of_the_current_suite():
+    """The test counts and times the README quotes were measured on the
+    suite as it is: each test command selects as many tests now as when
+    ``benchmarks/run_times.py`` measured it (a test added or removed since
+    fails here until the commands are measured again)."""
+    rt = _run_times()
+    store = rt.load()
+    stale = []
+    for key, args, _ in rt.TESTS:
+        now = rt.count_tests(args)
+        then = store.get(key, {}).get("collected")
+        if then != now:
+            stale.append("{}: measured on {} tests, the suite has {}".format(
+                key, then, now))
+    assert not stale, (
+        "the quoted test counts and times are of another suite ({}); "
+        "measure them again: python benchmarks/run_times.py --only {}"
+        .format("; ".join(stale), " ".join(k for k, _, _ in rt.TESTS)))
+
+
 def test_pages_are_written_atomically(tmp_path):
     """``update_results`` replaces a section through a temporary file:
     the page keeps its other text and its permissions, no temporary file

@@ -6,6 +6,7 @@ in the repository's ``meshes/`` (:func:`geo_path`).
 """
 import dataclasses
 import importlib.util
+import logging
 import os
 import tempfile
 
@@ -438,7 +439,16 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
             fn = os.path.join(tmp, "mesh.msh")
             gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
             gmsh.write(fn)
-            mesh = fem.Mesh.load(fn)
+            # scikit-fem's loader logs "Transforming over 1000 vertices to
+            # C_CONTIGUOUS" for every mesh read (its own transpose, which
+            # it copies at once): not a message for the user
+            log = logging.getLogger("skfem.mesh.mesh")
+            level = log.level
+            log.setLevel(logging.ERROR)
+            try:
+                mesh = fem.Mesh.load(fn)
+            finally:
+                log.setLevel(level)
     finally:
         gmsh.finalize()
     return renumber(mesh) if reorder and order == 1 else mesh
