@@ -12,4 +12,5 @@ from .curves import Curve
 
 __all__ = ["l2_error", "h1_error", "nodal_interpolant", "discrete_energy",
            "energy_capture", "linear_patch_test", "quadratic_patch_test",
-           "kirsch_displacement", "PATCH_GRADIENT_2D", "PATCH_GRADIENT_3D", "Curve"]
+           "kirsch_displacement", "PATCH_GRADIENT_2D", "PATCH_GRADIENT_3D",
+           "Curve"]

@@ -114,8 +114,9 @@ class Scene:
     ...                                 np.linspace(0, 1, 3))
     >>> mesh = mesh.with_boundaries({"left": lambda x: x[0] == 0,
     ...                              "right": lambda x: x[0] == 4})
-    >>> sc = Scene("strip", mesh, NeoHooke(lam=60.0, mu=40.0), clamped=["left"],
-    ...            tractions={"right": [1.0, 0.0]}, probes={"tip": (4.0, 1.0)})
+    >>> sc = Scene("strip", mesh, NeoHooke(lam=60.0, mu=40.0),
+    ...            clamped=["left"], tractions={"right": [1.0, 0.0]},
+    ...            probes={"tip": (4.0, 1.0)})
     >>> pg_tip = sc.solve("PG", verbose=False).probes["tip"][0]
     >>> q1_tip = sc.solve("Q1", verbose=False).probes["tip"][0]
     >>> bool(abs(pg_tip / q1_tip - 1) < 0.02)

@@ -19,8 +19,9 @@ records (:class:`Solution`, :class:`~skfem_pg.solvers.dynamics.Trajectory`).
 >>> basis = pg.FamilyBasis(mesh, dim=2)
 >>> f = np.zeros(basis.N)
 >>> f[basis.get_dofs(lambda x: x[0] == 4).nodal["u^2"]] = -0.02
->>> problem = pg.solvers.Problem(Hyperelastic(basis, NeoHooke(lam=10.0, mu=4.0)),
-...                              f_ext=f, D=basis.get_dofs(lambda x: x[0] == 0))
+>>> model = Hyperelastic(basis, NeoHooke(lam=10.0, mu=4.0))
+>>> problem = pg.solvers.Problem(model, f_ext=f,
+...                              D=basis.get_dofs(lambda x: x[0] == 0))
 >>> sol = pg.solvers.newton(problem, verbose=False)
 >>> sol.x.shape == (basis.N,), len(sol.history)
 (True, 1)

@@ -28,8 +28,9 @@ class Result:
     >>> from skfem_pg.materials import NeoHooke
     >>> mesh = fem.MeshQuad().refined(2).with_boundaries(
     ...     {"left": lambda x: x[0] == 0, "right": lambda x: x[0] == 1})
-    >>> res = Scene("block", mesh, NeoHooke(lam=60.0, mu=40.0), clamped=["left"],
-    ...             tractions={"right": [1.0, 0.0]}).solve("PG", verbose=False)
+    >>> res = Scene("block", mesh, NeoHooke(lam=60.0, mu=40.0),
+    ...             clamped=["left"], tractions={"right": [1.0, 0.0]}
+    ...             ).solve("PG", verbose=False)
     >>> res.u.shape == (res.basis.N,), res.history[-1]["load"]
     (True, 1.0)
 

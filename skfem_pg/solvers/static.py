@@ -192,7 +192,7 @@ def newton(model: Model, f_ext: ArrayLike | None = None, D=None,
     u = x0 if u0 is None else padded_vector(u0, n_u, N, "u0", x0)
     lin = solver if callable(solver) else condensed_solver(
         solver, basis, I, extra_fields=N > n_u,
-        symmetric=not f_ext.followers and None)
+        symmetric=False if f_ext.followers else None)
     stats = getattr(getattr(lin, "amg", None), "stats", {"iterations": []})
     lam = float(load0)
     dlam = (1.0 - lam) / opts.steps if lam < 1.0 else 1.0
