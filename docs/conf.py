@@ -13,6 +13,13 @@ import sys
 
 import skfem_pg
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import apipages  # noqa: E402  (docs/apipages.py)
+
+# one page per module, made from the package (docs/api/, not in git)
+apipages.write(os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                            "api"))
+
 project = "skfem-pg"
 author = "the skfem-pg developers"
 copyright = "skfem-pg developers, BSD-3-Clause"

@@ -43,10 +43,10 @@ class Curve:
         The point of the unloaded state, recorded first (default ``(0,
         0)``; ``None``: none).
 
-    Attributes
-    ----------
-    x, y, load : ndarray
-        The recorded points and their load factors.
+    Notes
+    -----
+    The recorded points are the arrays ``curve.x`` and ``curve.y``, their
+    load factors ``curve.load``.
     """
 
     def __init__(self, x: Callable, y: Callable, xlabel: str = "x",
