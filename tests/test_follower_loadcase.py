@@ -150,6 +150,11 @@ def test_follower_refusals():
         FollowerPressure(basis, np.arange(mesh.facets.shape[1]), 1.0)
     with pytest.raises(ValueError, match="empty"):
         FollowerPressure(basis, lambda x: x[0] > 5, 1.0)
+    with pytest.raises(ValueError, match="one value per facet"):
+        FollowerPressure(basis, mesh.boundary_facets(), [1.0, 2.0])
+    with pytest.raises(ValueError, match="pressure nan on facet"):
+        FollowerPressure(basis, mesh.boundary_facets(),
+                         lambda x: np.where(x[0] > 0.9, np.nan, 1.0))
     p2 = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad2()))
     with pytest.raises(NotImplementedError, match="linear vector elements"):
         FollowerPressure(p2, mesh.boundary_facets(), 1.0)

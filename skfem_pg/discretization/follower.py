@@ -187,10 +187,19 @@ class FollowerPressure:
         self.dofs = nodal[:, nodes]  # (d, nv, nf)
         if callable(pressure):
             pressure = pressure(self.X.mean(axis=1))
-        self.pressure = np.broadcast_to(
-            np.asarray(pressure, dtype=float), (len(facets),)).copy()
-        if not np.all(np.isfinite(self.pressure)):
-            raise ValueError("FollowerPressure: a non-finite pressure")
+        pressure = np.asarray(pressure, dtype=float)
+        if pressure.ndim > 1 or pressure.size not in (1, len(facets)):
+            raise ValueError(
+                "FollowerPressure: the pressure has shape {}; give a number "
+                "or one value per facet ({})".format(pressure.shape,
+                                                     len(facets)))
+        self.pressure = np.broadcast_to(pressure, (len(facets),)).copy()
+        bad = np.flatnonzero(~np.isfinite(self.pressure))
+        if len(bad):
+            raise ValueError(
+                "FollowerPressure: pressure {} on facet {} at {}".format(
+                    self.pressure[bad[0]], facets[bad[0]], np.round(
+                        self.X[:, :, bad[0]].mean(axis=1), 12).tolist()))
         rows = np.broadcast_to(self.dofs[:, :, None, None], (d, nv, d, nv)
                                + (len(facets),))
         cols = np.broadcast_to(self.dofs[None, None], rows.shape)
