@@ -91,7 +91,7 @@ def _mesh_and_dofs(basis):
         if nc != mesh.dim():
             raise ValueError("FollowerPressure acts on displacements: build "
                              "the basis with dim={}".format(mesh.dim()))
-        return mesh, nc * np.arange(mesh.p.shape[1]) + np.arange(nc)[:, None]
+        return mesh, basis.nodal_dofs  # scikit-fem's, of the vertex particles
     mesh = basis.mesh
     elem = getattr(basis, "elem", None)
     nodal = getattr(basis, "nodal_dofs", None)

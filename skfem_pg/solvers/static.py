@@ -413,9 +413,9 @@ class ExternalLoad:
     def tangent(self, K, u, lam):
         """``K - lam * df/du``: the loads' share of Newton's tangent."""
         for load in self.followers:
-            Kf = load.stiffness(u[:self.n_u]).tocoo()
-            K = K - lam * type(K)((Kf.data, (Kf.row, Kf.col)),
-                                  shape=K.shape)
+            Kf = load.stiffness(u[:self.n_u])  # (n_u, n_u) of (N, N)
+            Kf.resize(K.shape)
+            K = K - lam * Kf
         return K
 
 
