@@ -60,9 +60,11 @@ def demo_parser(doc, results=False, quick=True):
                     "$SKFEM_PG_OUT or ./out)")
     if quick:
         ap.add_argument("--quick", action="store_true",
-                        help="a run of seconds on small node sets (what "
-                        "tests/test_demos.py runs); the numbers it prints "
-                        "are not the demo's claims")
+                        help="a short run on small node sets (seconds; "
+                        "about a minute for the explicit fracture demos, "
+                        "which run several models to their first "
+                        "failures), what tests/test_demos.py runs; the "
+                        "numbers it prints are not the demo's claims")
     if results:
         ap.add_argument("--results", help="markdown page whose section of "
                         "this script is rewritten (e.g. "

@@ -22,7 +22,7 @@ from .discretization import (particles, families, shape, corrections,
 from .scenes import meshing, reference
 from .errors import (ParticleError, FamilyError, CorrectionError,
                      UnsupportedMeshError, SlowAssemblyWarning,
-                     MixedBasisWarning)
+                     MixedBasisWarning, SecondDerivativeError)
 from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
                              traction, stress_load, body_force)
@@ -43,7 +43,8 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "solvers", "analysis", "scenes", "families", "shape",
            "corrections", "vc", "meshing", "particles", "loads",
            "ParticleError", "FamilyError", "CorrectionError",
-           "UnsupportedMeshError", "registry", "register_formulation",
+           "UnsupportedMeshError", "SecondDerivativeError", "registry",
+           "register_formulation",
            "Scene", "newton", "newmark", "central_difference",
            "lumped_mass", "NewtonControls", "Problem", "loadcase",
            "FollowerPressure"]

@@ -31,6 +31,40 @@ class UnsupportedMeshError(TypeError):
     """The mesh type is not a linear scikit-fem mesh (tri, quad, tet, hex)."""
 
 
+class SecondDerivativeError(NotImplementedError):
+    """A form reads second derivatives (``dd(u)``, ``u.hess``) of basis
+    functions that carry first derivatives only."""
+
+
+class _FirstDerivativesOnly:
+    """Stands in for ``hess`` in the fields of a family basis: any use of
+    it raises :class:`SecondDerivativeError` instead of numpy's message
+    about a ``None`` operand.  The MTE/WTE derivatives (thesis Eqs.
+    (3.13)-(3.28)) are of first order; fourth-order problems (Kirchhoff
+    plates, the biharmonic stream function) need a C¹ or non-conforming
+    FE basis (Morley, Argyris)."""
+
+    def _refuse(self, *args, **kwargs):
+        raise SecondDerivativeError(
+            "the form reads second derivatives (dd(u) / u.hess) of a "
+            "FamilyBasis, whose basis functions carry first derivatives "
+            "only (MTE/WTE); pose a fourth-order problem on an FE basis "
+            "(e.g. ElementTriMorley, ElementTriArgyris) or in mixed form "
+            "with first derivatives")
+
+    __array__ = __array_function__ = __array_ufunc__ = __getitem__ = \
+        __mul__ = __rmul__ = __add__ = __radd__ = __sub__ = __rsub__ = \
+        __truediv__ = __rtruediv__ = __matmul__ = __rmatmul__ = __neg__ = \
+        __pow__ = __len__ = __iter__ = _refuse
+
+    def __repr__(self):
+        return "<no second derivatives: a FamilyBasis>"
+
+
+#: the ``hess`` of every field a family basis hands to a form
+NO_SECOND_DERIVATIVES = _FirstDerivativesOnly()
+
+
 class SlowAssemblyWarning(UserWarning):
     """scikit-fem's generic assembly runs on a FamilyBasis: correct, but
     far slower than :func:`skfem_pg.assemble`."""

@@ -79,8 +79,12 @@ def test_degenerate_element_is_rejected():
         pg.Particles.from_mesh(fem.MeshTri(p, t))
 
 
-def test_gmsh_file(tmp_path):
+def test_gmsh_file(tmp_path, capfd):
     mesh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"))
+    # meshing prints nothing (meshio's reader guess printed a blank line
+    # per mesh, issue 50)
+    out, err = capfd.readouterr()
+    assert out == "" and "C_CONTIGUOUS" not in err
     fn = str(tmp_path / "square.msh")
     mesh.save(fn)
     p = pg.Particles.from_file(fn)

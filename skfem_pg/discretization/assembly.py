@@ -44,6 +44,7 @@ from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField, ElementVector
 
 from .basis import FamilyBasis, form_roles
+from ..errors import NO_SECOND_DERIVATIVES
 from .shape.common import chunks
 from ..threads import kernel
 
@@ -189,8 +190,11 @@ def batched_view(basis):
 
 def _probes(view):
     """Unit probe fields: list of ``(component, channel, DiscreteField)``;
-    channel 0 is the value, channel ``1 + b`` the derivative ``∂_b``."""
+    channel 0 is the value, channel ``1 + b`` the derivative ``∂_b``.  A
+    family view's fields refuse second derivatives by name (an FE view's
+    fall back to scikit-fem's generic assembly, which has them)."""
     d, nc = view.dim, view.nc
+    hess = NO_SECOND_DERIVATIVES if isinstance(view, _FamilyView) else None
     out = []
     for a in range(nc):
         for beta in range(d + 1):
@@ -202,7 +206,7 @@ def _probes(view):
                 grad[a, beta - 1] = 1.0
             if view.scalar:
                 val, grad = val[0], grad[0]
-            out.append((a, beta, DiscreteField(val, grad)))
+            out.append((a, beta, DiscreteField(val, grad, hess=hess)))
     return out
 
 

@@ -52,7 +52,8 @@ from . import petrov
 from .builder import BasisSpec
 from .corrections import family_radii
 from ..dofs import as_dofs
-from ..errors import MixedBasisWarning, warn_slow_assembly
+from ..errors import (MixedBasisWarning, NO_SECOND_DERIVATIVES,
+                      warn_slow_assembly)
 from .particles import Particles, linear_elements
 from .quadrature import volume_weights
 from ..threads import kernel
@@ -529,12 +530,13 @@ class FamilyBasis(AbstractBasis):
             value = self.values[:, :, a].copy()
         grad = np.moveaxis(self.G[:, :, a, :], -1, 0)
         if self.ncomp is None:
-            return (DiscreteField(value, grad),)
+            return (DiscreteField(value, grad,
+                                  hess=NO_SECOND_DERIVATIVES),)
         V = np.zeros((nc, nf, m))
         V[c] = value
         Gr = np.zeros((nc,) + grad.shape)
         Gr[c] = grad
-        return (DiscreteField(V, Gr),)
+        return (DiscreteField(V, Gr, hess=NO_SECOND_DERIVATIVES),)
 
     @property
     def layout(self):
@@ -667,7 +669,7 @@ class FamilyBasis(AbstractBasis):
             grad = L.flat_to_padded(grad[..., None, :])
         if self.ncomp is None:
             value, grad = value[0], grad[0]
-        return DiscreteField(value, grad)
+        return DiscreteField(value, grad, hess=NO_SECOND_DERIVATIVES)
 
     # -- scikit-fem idioms -------------------------------------------------
     def _collocation_basis(self, what):

@@ -12,7 +12,9 @@ import tempfile
 
 import numpy as np
 import scipy.sparse as sp
+import meshio
 import skfem as fem
+from skfem.io.meshio import from_meshio
 
 #: Cook's membrane corners (thesis 7.1)
 COOK_CORNERS = np.array([[0.0, 0.0], [48.0, 44.0], [48.0, 60.0], [0.0, 44.0]])
@@ -446,7 +448,10 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
             level = log.level
             log.setLevel(logging.ERROR)
             try:
-                mesh = fem.Mesh.load(fn)
+                # the format named: meshio tries ANSYS first for .msh and
+                # prints that reader's empty error message, a blank line
+                # in the output of every script that meshes with gmsh
+                mesh = from_meshio(meshio.read(fn, file_format="gmsh"))
             finally:
                 log.setLevel(level)
     finally:
