@@ -76,8 +76,11 @@ def test_damage_at_fixed_triaxiality_is_the_closed_form():
     volume ratio J: σ_vM = A and the pressure K(J² - 1)/2 stay fixed, so
     the triaxiality σ* = K(J² - 1)/(2A) is constant and the damage is
     exactly ē_p / ε_f(σ*) step after step; the point fails in the step
-    where that reaches Dc, releases the energy it stored, and carries
-    nothing from then on (J > 1: no tension)."""
+    where that reaches Dc, releases the energy it stored less half the
+    work of its stress over that step (the drivers' trapezoid books
+    only the step's start, where it still carried stress: issue 51; on
+    these large plastic steps that half is 71 % of the stored energy),
+    and carries nothing from then on (J > 1: no tension)."""
     A = 792.0
     plastic = J2Plasticity.from_young(E, NU, hardening=JohnsonCookHardening(
         A, 0.0, 1.0), damage=JC_DAMAGE)
@@ -98,10 +101,13 @@ def test_damage_at_fixed_triaxiality_is_the_closed_form():
     # the energy it released is what it would have stored intact (the
     # plain law's, the same path up to there)
     intact = J2Plasticity.from_young(E, NU, hardening=plastic.hardening)
-    W = walk(intact, Fs[:first + 1])[-1].energy()[0]
+    end = walk(intact, Fs[:first + 1])[-1]
+    W = end.energy()[0]
+    half_work = 0.5 * np.sum(end.P[..., 0] * (Fs[first] - Fs[first - 1])[
+        ..., 0])
     released = [r.history["released"][0] for r in rs]
-    assert released[first - 1] == 0 and W > 0
-    assert abs(released[first] / W - 1) < 1e-12
+    assert released[first - 1] == 0 and W > half_work > 0
+    assert abs(released[first] / (W - half_work) - 1) < 1e-12
     assert np.all(np.array(released[first:]) == released[first])
     # after failure: no plastic flow, no stress in tension
     assert np.all(alpha[first:] == alpha[first])

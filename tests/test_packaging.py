@@ -39,13 +39,14 @@ def test_geo_sources_are_kept_once():
     top = sorted(f for f in os.listdir(os.path.join(ROOT, "meshes"))
                  if f.endswith(".geo"))
     assert top == ["beam3d.geo", "bracket.geo", "cook.geo", "cook3d.geo",
-                   "cube.geo", "plate_hole3d.geo", "plate_two_holes.geo",
-                   "square.geo"]
+                   "cube.geo", "plate_hole3d.geo", "plate_slot.geo",
+                   "plate_two_holes.geo", "square.geo"]
 
 
 def test_geo_path_finds_every_source_and_names_a_missing_one():
     for name in ("cook.geo", "cook3d.geo", "cube.geo", "square.geo",
-                 "beam3d.geo", "plate_hole3d.geo", "plate_two_holes.geo"):
+                 "beam3d.geo", "plate_hole3d.geo", "plate_slot.geo",
+                 "plate_two_holes.geo"):
         assert os.path.isfile(pg.meshing.geo_path(name))
     with pytest.raises(FileNotFoundError, match="cook.geo"):
         pg.meshing.geo_path("nothing.geo")

@@ -76,9 +76,18 @@ class BondState:
 
     stateful = True
 
-    def __init__(self, n_bonds):
-        self.committed = {"intact": np.ones(n_bonds),
-                          "broken_energy": np.zeros(())}
+    def __init__(self, n_bonds, dim):
+        self.committed = self.virgin(n_bonds, dim)
+
+    @staticmethod
+    def virgin(n_bonds, dim):
+        """All bonds intact, nothing released, no bond broken in the last
+        step (``last_force``, ``last_y``: the force and the deformed
+        vector of the bonds that broke at the last commit, zero
+        elsewhere)."""
+        return {"intact": np.ones(n_bonds), "broken_energy": np.zeros(()),
+                "last_force": np.zeros((dim, n_bonds)),
+                "last_y": np.zeros((dim, n_bonds))}
 
     @property
     def intact(self):
@@ -88,11 +97,10 @@ class BondState:
         return {k: np.array(v) for k, v in self.committed.items()}
 
     def restore(self, saved):
-        if saved is None:
-            saved = {"intact": np.ones_like(self.committed["intact"]),
-                     "broken_energy": np.zeros(())}
-        self.committed = {k: np.array(v, dtype=float)
-                          for k, v in saved.items()}
+        virgin = self.virgin(*self.committed["last_y"].shape[::-1])
+        # a checkpoint of an older version has no last-step arrays
+        self.committed = {k: np.array(v, dtype=float) for k, v in {
+            **virgin, **(saved or {})}.items()}
 
     def elastic_predictor(self):
         """Bonds have no plastic part: the model as it is."""
@@ -244,7 +252,7 @@ class BondBased:
         self.xi = p.x[:, j] - p.x[:, i]  # (d, nb)
         self.length = np.linalg.norm(self.xi, axis=0)
         self.VV = p.volumes[i] * p.volumes[j]
-        self.history = BondState(self.bonds.shape[0])
+        self.history = BondState(self.bonds.shape[0], self.dim)
         if cut is not None:
             across = np.asarray(cut(p.x[:, i], p.x[:, j]), dtype=bool)
             if across.shape != i.shape:
@@ -333,14 +341,35 @@ class BondBased:
     def commit(self, state):
         """Break, for good, the bonds stretched beyond :math:`s_0`; their
         stored energy is added to :attr:`broken_energy` (what the broken
-        bonds dissipated)."""
-        breaking = self.intact & (state["s"] > self.s0)
-        if breaking.any():
-            c = self.history.committed
+        bonds dissipated).
+
+        A bond that breaks at this commit still pulled with its force at
+        this state, which the drivers' internal force of the step holds
+        (the bond-based convention: it is gone from the next evaluation
+        on), so the trapezoid of the next step books half of its work
+        over that step; the next commit adds that half,
+        :math:`\tfrac12 t\cdot\Delta y`, to :attr:`broken_energy`, which
+        then equals the work the integrator booked on the bond (a broken
+        bond stores nothing): exact where the trapezoid is."""
+        c = self.history.committed
+        last = np.flatnonzero(np.any(c["last_force"] != 0, axis=0))
+        if last.size:  # the bonds of the last commit: their last half step
+            dy = state["y"][:, last] - c["last_y"][:, last]
+            c["broken_energy"] = c["broken_energy"] + 0.5 * np.sum(
+                c["last_force"][:, last] * dy)
+            c["last_force"][:, last] = 0.0
+            c["last_y"][:, last] = 0.0
+        breaking = np.flatnonzero(self.intact & (state["s"] > self.s0))
+        if breaking.size:
+            s = state["s"][breaking]
             c["broken_energy"] = c["broken_energy"] + np.sum(
-                0.5 * self.c * state["s"][breaking] ** 2
-                * self.length[breaking] * self.VV[breaking])
-            c["intact"] = np.where(breaking, 0.0, c["intact"])
+                0.5 * self.c * s ** 2 * self.length[breaking]
+                * self.VV[breaking])
+            y = state["y"][:, breaking]
+            c["last_force"][:, breaking] = (self.c * s * self.VV[breaking]
+                                            / np.linalg.norm(y, axis=0) * y)
+            c["last_y"][:, breaking] = y
+            c["intact"][breaking] = 0.0
 
     def fields(self, x):
         return {}

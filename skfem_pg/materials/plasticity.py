@@ -219,7 +219,9 @@ class J2Plasticity(Material):
         """The virgin state at points of shape ``point_shape``:
         ``Cp_inv`` ``(3, 3, *point_shape)`` the identity, ``alpha`` (and
         with a damage law ``damage`` and ``released``, the energy density
-        a point released when it failed) zero."""
+        a point released when it failed) zero; with a damage law also
+        ``F_last``, the committed deformation gradient (3-D, the
+        identity), against which a failing point's step is booked."""
         shape = tuple(point_shape)
         Cp = np.broadcast_to(np.eye(3).reshape((3, 3) + (1,) * len(shape)),
                              (3, 3) + shape).copy()
@@ -227,6 +229,7 @@ class J2Plasticity(Material):
         if self.damage is not None:
             h["damage"] = np.zeros(shape)
             h["released"] = np.zeros(shape)
+            h["F_last"] = Cp.copy()  # the committed F (3-D), identity
         return h
 
     # -- the stress update ---------------------------------------------
@@ -405,6 +408,7 @@ class Response:
         bad = ~np.all(np.isfinite(F3), axis=(1, 2))
         if bad.any():
             F3[bad] = np.eye(3)
+        self._F3 = F3
         Cpn = np.moveaxis(Cp, 2, 0)
         self._G = F3 @ Cpn  # F C_p,n^-1
         btr = self._G @ np.swapaxes(F3, 1, 2)
@@ -462,6 +466,8 @@ class Response:
         if m.damage is not None:
             self.history["damage"] = damage.reshape(self.point_shape)
             self.history["released"] = released.reshape(self.point_shape)
+            self.history["F_last"] = np.moveaxis(self._F3, 0, 2).reshape(
+                (3, 3) + self.point_shape)
         self._A = None
         self._spectral = None
 
@@ -512,15 +518,41 @@ class Response:
         now = failed & (history["damage"].reshape(n) < m.damage.Dc)
         if now.any():
             Jn = J[now]
+            tension = Jn >= 1  # the volumetric part goes too
             released[now] += 0.5 * m.mu * (self._trbb[now] - 3) + \
-                np.where(Jn >= 1, 0.25 * m.K * (Jn ** 2 - 1
+                np.where(tension, 0.25 * m.K * (Jn ** 2 - 1
                                                 - 2 * np.log(Jn)), 0.0)
+            released[now] -= self._dropped_work(history, now, tau_full,
+                                                vol, tension)
         # a failed point: no deviatoric stress, pressure only in
         # compression (module docstring of skfem_pg.materials.damage)
         tau_full[failed] = 0.0
         self._trbb[failed] = 3.0
         return damage, released, failed, np.where(failed & (J >= 1), 0.0,
                                                   vol)
+
+    def _dropped_work(self, history, now, tau_full, vol, tension):
+        r"""Half the work of the stress the points ``now`` drop, over the
+        step: :math:`\tfrac12 (P - P_{failed}) : (F - F_n)` per unit
+        volume.  A point failing in a step carries its failed stress at
+        the step's end, so the step's work (the trapezoid of the internal
+        forces, as the explicit and Newmark drivers book it) took only
+        the intact stress at its start; the energy the point releases is
+        its intact energy at the end less this half (to third order in
+        the step; exact bookkeeping against the driver's work for total
+        Lagrangian forces, :math:`f\cdot\Delta u = \sum V P:\Delta F`).
+        Zero for a history without ``F_last`` (a checkpoint of an older
+        version)."""
+        F_last = history.get("F_last")
+        if F_last is None:
+            return 0.0
+        n = self._F3.shape[0]
+        dF = self._F3[now] - np.moveaxis(F_last.reshape(3, 3, n), 2, 0)[now]
+        drop = tau_full[now].copy()  # deviatoric, intact
+        for i in range(3):
+            drop[:, i, i] += np.where(tension, vol[now], 0.0)
+        P = drop @ np.swapaxes(self._Finv[now], 1, 2)
+        return 0.5 * np.einsum("kij,kij->k", P, dF)
 
     def spectral(self):
         """``(beta, Q, tau, dtau/dxtr)`` at every point: eigenvalues and

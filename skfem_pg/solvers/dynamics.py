@@ -10,6 +10,14 @@ Energy bookkeeping (printed as a run goes and stored per output):
   energy plus the plastic dissipation;
 * stored energy :math:`\Pi = \sum w\, W(F)` where the model offers it
   (``model.energy``), and the dissipation :math:`W_{int} - \Pi`;
+* where the model fractures (``model.fracture_energy``): the energy the
+  failed points, broken bonds and crack updates released, :math:`R`,
+  booked as the integrator books the work of the step in which they fail
+  (:func:`book_rebuild`; a point's :meth:`~skfem_pg.materials.
+  J2Plasticity.update`), and the rest of the dissipation,
+  ``other_dissipation`` :math:`= W_{int} - \Pi - R`: the plastic
+  dissipation, zero to :math:`O(\Delta t^2)` for an elastic material
+  with a brittle criterion (the independent check of the booking);
 * external work :math:`W_{ext}` of the loads (trapezoidal), work of the
   reactions at prescribed dofs :math:`W_D` (:math:`R = f_{int} -
   f_{ext}` there), and the energy the wall took at impacts
@@ -231,6 +239,26 @@ def commit(model, state, t, x, v, hist):
                             history=hist) from None
 
 
+def book_rebuild(model, dot, f_before, f_after, du, root=True):
+    r"""After a commit that changed the model's discretization at the end
+    of a step (crack-aware families rebuilt, bonds broken): the driver
+    books the step's work with the force of the new discretization, so
+    the energy the model released at the step's end
+    (``model.fracture_energy``) is corrected by
+    :math:`-\tfrac12 (f_{before} - f_{after})\cdot\Delta u`, the half of
+    the removed forces' work the trapezoid no longer counts
+    (``model.book_removed_work``; exact to third order in the step).
+    ``dot``: the sum over the dofs (over all ranks on MPI: collective);
+    ``root``: whether this part books it (a model's released energy is
+    summed over the ranks, so one rank books the whole sum)."""
+    book = getattr(model, "book_removed_work", None)
+    if book is not None:
+        n = len(du)
+        work = -0.5 * dot(np.asarray(f_before)[:n] - np.asarray(f_after)[:n],
+                          du)
+        book(work if root else 0.0)
+
+
 @dataclass
 class Trajectory:
     """A time integration's result: the unknowns ``x`` (displacements
@@ -437,6 +465,8 @@ class Recorder:
             # part of the dissipation: what failed points or broken bonds
             # had stored when they failed
             rec["fracture"] = fracture
+            if "stored" in rec:
+                rec["other_dissipation"] = rec["dissipation"] - fracture
         rec.update(data)
         self.hist.append(rec)
         self.progress(t, data["dt"], data["steps"], rec, force=final)

@@ -52,8 +52,8 @@ from .exchange import SerialExchange
 from .controls import ExplicitControls
 from .dynamics import (DynamicsError, EnergyBalance, MAX_STEPS, Progress,
                        Recorder, Timings, Trajectory, bind_problem,
-                       bind_walls, check_run, commit, resume_run, save_run,
-                       stored_energy)
+                       bind_walls, book_rebuild, check_run, commit,
+                       resume_run, save_run, stored_energy)
 from .problem import Problem
 from ..discretization.particles import inverted_cells
 
@@ -372,6 +372,7 @@ class _CentralDifference:
         self.callback = callback
         self.t, self.steps, self.step = 0.0, 0, dt
         self.F_est = None  # the deformation at the last estimate
+        self.rebuilt = False  # the model's basis changed since
         self.output_every = controls.output_every
 
     # -- the start ------------------------------------------------------
@@ -408,6 +409,7 @@ class _CentralDifference:
             saved["step"]), float(saved["base"])
         self.output_every = int(saved["output_every"])
         self.F_est = saved.get("F_est")
+        self.rebuilt = bool(saved.get("rebuilt", False))
         self.state = _evaluate(self.model, self.u, self.t, self.hist,
                                self.v, exchange=ex)
         self.fe = run.f_of(self.t)
@@ -455,9 +457,10 @@ class _CentralDifference:
                 ratio = self.ex.max(compression_since(
                     self.F_est, _gradients(self.state)))
                 if self.steps % self.c.estimate_every == 0 \
-                        or ratio > REESTIMATE:
+                        or ratio > REESTIMATE or self.rebuilt:
                     self.base = self.estimate(self.c.safety)
                     self.F_est, ratio = _gradients(self.state), 1.0
+                    self.rebuilt = False
                 self.step = self.base / ratio
         step, t = self.step, self.t
         if not (np.isfinite(step) and step > 0) \
@@ -484,7 +487,15 @@ class _CentralDifference:
                            self.hist):
                 state = _evaluate(model, un, t, self.hist, self.v, self.u,
                                   exchange=ex)
+                fi_before = fi_n
                 fi_n = ex.complete(model.internal_force(state))
+                # a new basis has its own highest frequency (a crack's
+                # families raise it): estimate it before the next step,
+                # also where the points' count (compression_since's
+                # signal) happens to stay the same
+                self.rebuilt = True
+                book_rebuild(model, ex.dot, fi_before, fi_n,
+                             (un - self.u)[:model.n_u], ex.root)
         return state, fi_n
 
     def advance(self):
@@ -550,6 +561,7 @@ class _CentralDifference:
                  self.a, self.fi, self.held, self.energy, self.hist,
                  "explicit", steps=self.steps, step=self.step,
                  base=self.base, output_every=self.output_every,
+                 rebuilt=float(self.rebuilt),
                  **({} if self.F_est is None else {"F_est": self.F_est}))
 
     def trajectory(self):

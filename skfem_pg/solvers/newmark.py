@@ -39,8 +39,9 @@ from ..dofs import check_sliding
 from .contact import hold_initial
 from .checkpoint import Every
 from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
-                       Timings, Trajectory, bind_problem, check_run, commit,
-                       resume_run, save_run, stored_energy)
+                       Timings, Trajectory, bind_problem, book_rebuild,
+                       check_run, commit, resume_run, save_run,
+                       stored_energy)
 from .controls import NewmarkControls
 from .problem import Problem
 from .static import condensed_solver, newton_step
@@ -294,7 +295,10 @@ class _Newmark:
             # the families were rebuilt: the force and the acceleration
             # of the new basis (lumped mass)
             state = model.state(xn)
+            fi_before = fi_n
             fi_n = np.asarray(model.internal_force(state), dtype=float)
+            book_rebuild(model, self.energy.dot, fi_before, fi_n,
+                         (xn - self.x)[:n_u])
             an, moving = np.array(an), run.free & ~held_n
             an[moving] = (fe_n[:n_u] - fi_n[:n_u])[moving] / run.m[moving]
         touched = np.flatnonzero(self.held | held_n)
