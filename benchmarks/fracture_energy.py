@@ -45,11 +45,11 @@ from skfem_pg.formulations import BondBased, CrackAware, model_for, \
     segment_cut
 from skfem_pg.formulations.crack_aware import cell_failure
 from skfem_pg.materials import CriticalStrainDamage, J2Plasticity
-from skfem_pg.solvers import DynamicsError
+from skfem_pg.solvers import DynamicsError, ExplicitControls
 
 #: N, mm, s: maraging steel (Kalthoff–Winkler, demos/kalthoff_winkler.py)
 E, NU, G0, RHO = 190e3, 0.3, 22.17, 8e-9
-SAFETY = 0.8  # ExplicitControls' default
+SAFETY = ExplicitControls().safety  # the default stable-step factor
 
 
 def model_of(kind, mesh, h):

@@ -37,18 +37,20 @@ class SecondDerivativeError(NotImplementedError):
 
 
 class _FirstDerivativesOnly:
-    """Stands in for ``hess`` in the fields of a family basis: any use of
-    it raises :class:`SecondDerivativeError` instead of numpy's message
-    about a ``None`` operand.  The MTE/WTE derivatives (thesis Eqs.
-    (3.13)-(3.28)) are of first order; fourth-order problems (Kirchhoff
-    plates, the biharmonic stream function) need a C¹ or non-conforming
-    FE basis (Morley, Argyris)."""
+    """Stands in for ``hess`` in the fields of a particle basis (family
+    and PG2): any use of it raises :class:`SecondDerivativeError` instead
+    of numpy's message about a ``None`` operand.  The shape functions
+    carry values and first derivatives only (MTE1 (5.52), WTE1/WTE2, the
+    PG2 fits); fourth-order problems (Kirchhoff plates, the biharmonic
+    stream function) need a C¹ or non-conforming FE basis (Morley,
+    Argyris)."""
 
     def _refuse(self, *args, **kwargs):
         raise SecondDerivativeError(
             "the form reads second derivatives (dd(u) / u.hess) of a "
-            "FamilyBasis, whose basis functions carry first derivatives "
-            "only (MTE/WTE); pose a fourth-order problem on an FE basis "
+            "particle basis (FamilyBasis, PG2), whose basis functions carry "
+            "values and first derivatives only; pose a fourth-order "
+            "problem on an FE basis "
             "(e.g. ElementTriMorley, ElementTriArgyris) or in mixed form "
             "with first derivatives")
 

@@ -191,10 +191,11 @@ def batched_view(basis):
 def _probes(view):
     """Unit probe fields: list of ``(component, channel, DiscreteField)``;
     channel 0 is the value, channel ``1 + b`` the derivative ``∂_b``.  A
-    family view's fields refuse second derivatives by name (an FE view's
-    fall back to scikit-fem's generic assembly, which has them)."""
+    particle basis' fields (family, PG2) refuse second derivatives by
+    name; an FE view's fall back to scikit-fem's generic assembly, which
+    has them."""
     d, nc = view.dim, view.nc
-    hess = NO_SECOND_DERIVATIVES if isinstance(view, _FamilyView) else None
+    hess = None if isinstance(view, _CellView) else NO_SECOND_DERIVATIVES
     out = []
     for a in range(nc):
         for beta in range(d + 1):

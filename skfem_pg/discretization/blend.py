@@ -53,7 +53,8 @@ import skfem as fem
 from skfem.assembly.basis import AbstractBasis
 from skfem.element import DiscreteField
 
-from ..errors import FamilyError, warn_slow_assembly
+from ..errors import (FamilyError, NO_SECOND_DERIVATIVES,
+                      warn_slow_assembly)
 from .particles import Particles, linear_elements
 from .shape.common import FamilyGeometry, chunks
 from .shape.quadratic import (taylor2_basis, taylor2_derivatives,
@@ -310,12 +311,13 @@ class _LazyFunctions(Sequence):
         Gh = b.values[:, :, s]  # (ne, nq, 1 + d)
         value, grad = Gh[..., 0], np.moveaxis(Gh[..., 1:], -1, 0)
         if b.ncomp is None:
-            return (DiscreteField(value, grad),)
+            return (DiscreteField(value, grad,
+                                  hess=NO_SECOND_DERIVATIVES),)
         d = grad.shape[0]
         V = np.zeros((nc,) + value.shape)
         G = np.zeros((nc, d) + value.shape)
         V[a], G[a] = value, grad
-        return (DiscreteField(V, G),)
+        return (DiscreteField(V, G, hess=NO_SECOND_DERIVATIVES),)
 
 
 class BlendBasis(AbstractBasis):
@@ -496,10 +498,12 @@ class BlendBasis(AbstractBasis):
         if self.ncomp is None:
             uu = w[self.conn]  # (ne, L)
             out = np.einsum("eqlc,el->ceq", Gh, uu)
-            return DiscreteField(out[0], out[1:])
+            return DiscreteField(out[0], out[1:],
+                                 hess=NO_SECOND_DERIVATIVES)
         uu = w.reshape(-1, self.ncomp)[self.conn]  # (ne, L, nc)
         out = np.einsum("eqlc,ela->aceq", Gh, uu)
-        return DiscreteField(out[:, 0], out[:, 1:])
+        return DiscreteField(out[:, 0], out[:, 1:],
+                             hess=NO_SECOND_DERIVATIVES)
 
     def boundary(self, facets=None):
         """The same shape functions at the Gauss points of boundary

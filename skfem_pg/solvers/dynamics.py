@@ -13,8 +13,9 @@ Energy bookkeeping (printed as a run goes and stored per output):
 * where the model fractures (``model.fracture_energy``): the energy the
   failed points, broken bonds and crack updates released, :math:`R`,
   booked as the integrator books the work of the step in which they fail
-  (:func:`book_rebuild`; a point's :meth:`~skfem_pg.materials.
-  J2Plasticity.update`), and the rest of the dissipation,
+  (a point's :meth:`~skfem_pg.materials.J2Plasticity.update`, a bond's
+  ``BondBased.commit``, a crack update's :func:`book_rebuild`), and the
+  rest of the dissipation,
   ``other_dissipation`` :math:`= W_{int} - \Pi - R`: the plastic
   dissipation, zero to :math:`O(\Delta t^2)` for an elastic material
   with a brittle criterion (the independent check of the booking);
@@ -241,7 +242,7 @@ def commit(model, state, t, x, v, hist):
 
 def book_rebuild(model, dot, f_before, f_after, du, root=True):
     r"""After a commit that changed the model's discretization at the end
-    of a step (crack-aware families rebuilt, bonds broken): the driver
+    of a step (crack-aware families rebuilt): the driver
     books the step's work with the force of the new discretization, so
     the energy the model released at the step's end
     (``model.fracture_energy``) is corrected by

@@ -450,8 +450,9 @@ class _CentralDifference:
     # -- a step ---------------------------------------------------------
     def step_size(self):
         """The step: the estimate scaled down by the compression since it
-        was made, estimated again every ``estimate_every`` steps or when
-        that scaling passes :data:`REESTIMATE` (``dt=None``)."""
+        was made, estimated again every ``estimate_every`` steps, when
+        that scaling passes :data:`REESTIMATE` or after the model rebuilt
+        its basis (``dt=None``)."""
         if self.dt is None and self.steps:
             with self.times("estimate"):
                 ratio = self.ex.max(compression_since(
