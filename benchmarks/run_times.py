@@ -108,6 +108,10 @@ SCRIPTS = [
      "Kalthoff–Winkler impact with the bond-based comparator (PMB) and PG "
      "Unl with a brittle criterion (connectivity kept, crack-aware): the "
      "crack angles against the experiment's 70 degrees", "2 min", 120),
+    ("poiseuille", ["demos/poiseuille.py"],
+     "thesis 8.2 / Fig. 8.2: Poiseuille start-up of water, PG Unl+P1C, "
+     "PBG Unl (locks), FE Q1, Q1P0 against the analytic series; VTU "
+     "series", "30 s", 30),
     ("cook_mpi", ["demos/cook_mpi.py"],
      "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
      "Newton and KSP iterations, difference to the serial run (serial "

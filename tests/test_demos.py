@@ -206,6 +206,14 @@ def _kalthoff_winkler(out):
     assert 55.0 <= kept[0] <= 70.0
 
 
+def _poiseuille(out):
+    # err t=0.1, err end, centre/exact, s; quick: 9 x 9 particles
+    (pg,) = _rows(out, "VCBCPBG V5m Unl+P1C")
+    (unl,) = _rows(out, "PBG Unl")
+    assert pg[0] <= 0.03 and pg[1] <= 0.03  # measured 2.3e-2, 2.9e-2
+    assert abs(unl[-2]) <= 0.02  # locks: measured -0.9 %
+
+
 CHECKS = {
     "necking.py": (_necking, "necking.png"),
     "torsion.py": (_torsion, "torsion.png"),
@@ -229,6 +237,7 @@ CHECKS = {
     "cook_dynamic.py": (_cook_dynamic, "cook_dynamic.png"),
     "two_hole_plate.py": (_two_hole_plate, "two_hole_plate.png"),
     "kalthoff_winkler.py": (_kalthoff_winkler, "kalthoff_winkler.png"),
+    "poiseuille.py": (_poiseuille, "poiseuille.png"),
 }
 
 

@@ -79,12 +79,26 @@ def test_degenerate_element_is_rejected():
         pg.Particles.from_mesh(fem.MeshTri(p, t))
 
 
-def test_gmsh_file(tmp_path, capfd):
+def test_gmsh_file(tmp_path, capfd, caplog):
     mesh = pg.meshing.from_geo(pg.meshing.geo_path("square.geo"))
     # meshing prints nothing (meshio's reader guess printed a blank line
     # per mesh, issue 50)
     out, err = capfd.readouterr()
     assert out == "" and "C_CONTIGUOUS" not in err
+    # a .geo with a physical surface and no physical curves: scikit-fem
+    # warned "Failure to parse tags" looking for the facets' tags
+    geo = tmp_path / "tagged.geo"
+    geo.write_text("Point(1) = {0, 0, 0, 1}; Point(2) = {1, 0, 0, 1};\n"
+                   "Point(3) = {1, 1, 0, 1}; Point(4) = {0, 1, 0, 1};\n"
+                   "Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4};\n"
+                   "Line(4) = {4, 1}; Curve Loop(1) = {1, 2, 3, 4};\n"
+                   "Plane Surface(1) = {1};\n"
+                   "Physical Surface(\"plate\") = {1};\n")
+    tagged = pg.meshing.from_geo(str(geo), size=0.5)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+    assert [r.getMessage() for r in caplog.records] == []
+    assert len(tagged.subdomains["plate"]) == tagged.nelements
     fn = str(tmp_path / "square.msh")
     mesh.save(fn)
     p = pg.Particles.from_file(fn)

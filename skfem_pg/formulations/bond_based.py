@@ -339,7 +339,7 @@ class BondBased:
         return 1.0
 
     def commit(self, state):
-        """Break, for good, the bonds stretched beyond :math:`s_0`; their
+        r"""Break, for good, the bonds stretched beyond :math:`s_0`; their
         stored energy is added to :attr:`broken_energy` (what the broken
         bonds dissipated).
 

@@ -56,7 +56,8 @@ import numpy as np
 
 from ..discretization.assembly import assemble
 from ..discretization.elementwise import Elements
-from ..materials import J2Plasticity, NeoHookeIsoVol, inverse_and_det
+from ..materials import (J2Plasticity, NeoHookeIsoVol, NewtonianFluid,
+                         check_moduli, inverse_and_det)
 from ..threads import kernel
 from .displacement import Hyperelastic, material_tangent
 from .history import History
@@ -74,12 +75,13 @@ def compressible_moduli(material, formulation):
     """``(mu, K)`` of an iso/vol neo-Hooke material with a finite bulk
     modulus, which the condensed and nodal mixed formulations need;
     anything else raises naming ``formulation``."""
-    if not isinstance(material, (NeoHookeIsoVol, J2Plasticity)) \
+    if not isinstance(material, (NeoHookeIsoVol, J2Plasticity,
+                                 NewtonianFluid)) \
             or not np.isfinite(material.K):
         raise ValueError("{} needs the iso/vol neo-Hooke material "
-                         "(NeoHookeIsoVol) or J2Plasticity with a finite "
-                         "bulk modulus, got {!r}".format(formulation,
-                                                         material))
+                         "(NeoHookeIsoVol), J2Plasticity or a "
+                         "NewtonianFluid with a finite bulk modulus, got {!r}"
+                         .format(formulation, material))
     return material.mu, material.K
 
 
@@ -112,7 +114,7 @@ class MeanDilatation(Hyperelastic):
                 "(the dilatation at the master, Theta^k = J^kk) is "
                 "MasterDilatation")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
+        (self.K,) = check_moduli(K=K)
         self.order = int(order)
         E = self.elements = Elements(basis)
         self.Phi = E.polynomials(self.order)

@@ -209,6 +209,16 @@ class Hyperelastic:
                     + self._eye}
         return {"F": self.basis.interpolate(u).grad + self._eye}
 
+    def rate_gradient(self, w):
+        """The gradient of the nodal displacement-dof vector ``w`` at the
+        points where the material lives, in the layout of ``state(u)["F"]``
+        — how a driver gives a rate-dependent material its velocity
+        gradient (:mod:`skfem_pg.solvers.rates`)."""
+        w = np.asarray(w, dtype=float)[:self.n_u]
+        if is_family_basis(self.point_basis):
+            return self.point_basis.interpolate(w, flat=True).grad
+        return self.point_basis.interpolate(w).grad
+
     def energy(self, state):
         """Stored energy :math:`\\sum w\\, W(F)` of ``state``."""
         dx = (self.basis.flat_weights() if is_family_basis(self.basis)

@@ -35,7 +35,7 @@ import numpy as np
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.petrov import reverse_slots
-from ..materials import NeoHookeIsoVol, inverse_and_det
+from ..materials import NeoHookeIsoVol, check_moduli, inverse_and_det
 from ..threads import kernel
 from .dilatation import d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, material_tangent
@@ -82,7 +82,7 @@ class MasterDilatation(Hyperelastic):
                 "whole necking bar)"
                 .format(basis.vc_boundary))
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
+        (self.K,) = check_moduli(K=K)
         p, fam = basis.particles, basis.families
         fam.require_every_master(p.x, "PPG UnlP0 / IUnlP0")
         mem, mask = fam.padded()

@@ -47,7 +47,8 @@ import numpy as np
 
 from ..discretization.assembly import FixedPattern, assemble
 from ..discretization.elementwise import Elements
-from ..materials import NeoHookeIsoVol, ReturnMapError, inverse_and_det
+from ..materials import (NeoHookeIsoVol, ReturnMapError, check_moduli,
+                         inverse_and_det)
 from ..threads import kernel
 from .dilatation import d_JFinvT, compressible_moduli
 from .displacement import Hyperelastic, internal_force, material_tangent
@@ -114,7 +115,7 @@ class NodalPressure(Hyperelastic):
                 "family_quadrature='moments' the quadrature points are not "
                 "members: use the members (the default)")
         super().__init__(basis, NeoHookeIsoVol.isochoric(mu))
-        self.K = float(NeoHookeIsoVol(mu=mu, K=K).K)  # checked
+        (self.K,) = check_moduli(K=K)
         self.bubble = bool(bubble)
         p = basis.particles
         self.n = p.n

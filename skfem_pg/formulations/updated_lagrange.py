@@ -174,6 +174,13 @@ class UpdatedLagrange(Hyperelastic):
                                                   self.F_c)
         return {"F": F, "dF": dF, "u": u}
 
+    def rate_gradient(self, w):
+        r""":math:`\nabla_X w = \nabla_c w\, F_c` at the current points
+        (:meth:`Hyperelastic.rate_gradient`)."""
+        g = super().rate_gradient(w)
+        return g if self.F_c is None else np.einsum("ikpq,kjpq->ijpq", g,
+                                                    self.F_c)
+
     def _to_current(self, P):
         if self.F_c is None:
             return P

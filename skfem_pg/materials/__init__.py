@@ -9,9 +9,11 @@ from .plasticity import J2Plasticity, ReturnMapError
 from .hardening import LinearSaturation, JohnsonCookHardening
 from .damage import CriticalStrainDamage, JohnsonCookDamage
 from .library import FElupeMaterial
+from .viscous import NewtonianFluid, NoRateError
 
 __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
            "inverse_and_det", "J2Plasticity", "ReturnMapError",
            "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage",
-           "CriticalStrainDamage", "FElupeMaterial"]
+           "CriticalStrainDamage", "FElupeMaterial", "NewtonianFluid",
+           "NoRateError"]

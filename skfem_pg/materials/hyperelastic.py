@@ -279,8 +279,14 @@ class NeoHookeIsoVol(Material):
     @classmethod
     def isochoric(cls, mu):
         """The isochoric part alone (``K = 0``), e.g. for a mean-dilatation
-        model that adds the volumetric part per element."""
-        m = cls(mu=mu, K=1.0)
+        model that adds the volumetric part per element; ``mu = 0`` is a
+        fluid's (:class:`~skfem_pg.materials.NewtonianFluid`, whose
+        viscous part the model then binds)."""
+        if mu == 0:
+            m = cls(mu=1.0, K=1.0)
+            m.mu = 0.0
+        else:
+            m = cls(mu=mu, K=1.0)
         m.K = 0.0
         return m
 

@@ -444,16 +444,24 @@ def from_geo(path, size=None, order=1, algorithm=None, recombine=False,
             # scikit-fem's loader logs "Transforming over 1000 vertices to
             # C_CONTIGUOUS" for every mesh read (its own transpose, which
             # it copies at once): not a message for the user
-            log = logging.getLogger("skfem.mesh.mesh")
-            level = log.level
-            log.setLevel(logging.ERROR)
+            # the format named: meshio tries ANSYS first for .msh and
+            # prints that reader's empty error message, a blank line
+            # in the output of every script that meshes with gmsh
+            m = meshio.read(fn, file_format="gmsh")
+            quiet = [logging.getLogger("skfem.mesh.mesh")]
+            if not any(c.dim == dim - 1 for c in m.cells):
+                # no physical curves (surfaces) in the .geo: scikit-fem
+                # warns "Failure to parse tags" looking for their facets,
+                # and keeps the subdomains
+                quiet.append(logging.getLogger("skfem.io.meshio"))
+            levels = [log.level for log in quiet]
+            for log in quiet:
+                log.setLevel(logging.ERROR)
             try:
-                # the format named: meshio tries ANSYS first for .msh and
-                # prints that reader's empty error message, a blank line
-                # in the output of every script that meshes with gmsh
-                mesh = from_meshio(meshio.read(fn, file_format="gmsh"))
+                mesh = from_meshio(m)
             finally:
-                log.setLevel(level)
+                for log, level in zip(quiet, levels):
+                    log.setLevel(level)
     finally:
         gmsh.finalize()
     return renumber(mesh) if reorder and order == 1 else mesh

@@ -64,8 +64,10 @@ class NewtonControls(Controls):
         fields: with pressures and dilatations as unknowns the residual
         norm mixes units); or, once the residual stops decreasing (its
         round-off floor, set by the bulk modulus and not by the load),
-        that energy below ``ROUNDOFF_ENERGY · tol`` (:mod:`~skfem_pg.solvers.static`) times the first
-        (the history's ``reason`` then says "round-off floor").
+        that energy below ``ROUNDOFF_ENERGY · tol`` (:mod:`~skfem_pg.solvers.static`) times the first,
+        or, flat for three iterations below ``STALL_RESIDUAL`` of the
+        reference norm, below ``ROUNDOFF_ENERGY`` times the first (the
+        history's ``reason`` then says "round-off floor").
     maxiter
         Newton iterations per load step at most.
     min_step

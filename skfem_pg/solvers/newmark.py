@@ -44,6 +44,7 @@ from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
                        stored_energy)
 from .controls import NewmarkControls
 from .problem import Problem
+from .rates import bind_newmark_rate, start_newmark_rate, unbind_rate
 from .static import condensed_solver, newton_step
 
 
@@ -198,11 +199,15 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
         check_conditional_stability(model, m, x, run.free, dt, c.beta,
                                     c.gamma, N == n_u)
     stepper = _Newmark(run, c, t_end, dt, solver, callback)
-    stepper.start(x, v, resume)
-    every = Every.of(checkpoint)
-    while stepper.t < t_end * (1 - 1e-12):
-        if stepper.advance() and every is not None:
-            stepper.save(every)
+    try:
+        start_newmark_rate(model, x, v, dt, c.beta, c.gamma)
+        stepper.start(x, v, resume)
+        every = Every.of(checkpoint)
+        while stepper.t < t_end * (1 - 1e-12):
+            if stepper.advance() and every is not None:
+                stepper.save(every)
+    finally:
+        unbind_rate(model)  # a viscous material's rate is this run's
     stepper.times["total"] = sum(stepper.times.values())
     return Trajectory(stepper.x, stepper.v, stepper.a, stepper.t,
                       stepper.hist, stepper.steps, dict(stepper.times))
@@ -264,6 +269,8 @@ class _Newmark:
     def advance(self):
         """Try one step; ``False`` if it failed and was halved."""
         t, h = self.t, min(self.step, self.t_end - self.t)
+        bind_newmark_rate(self.model, h, self.c.beta, self.c.gamma, self.v,
+                          self.a)
         ok, res = _step(self.run, self.c, (self.x, self.v, self.a,
                                             self.held), t, h, self.solver,
                         self.solvers, self.times)

@@ -32,6 +32,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ..formulations.protocol import require_model
+from .rates import refuse_rate_dependent
 
 #: the convenience keywords of the drivers and the field each fills
 KEYWORDS = {"f_ext": "f_ext", "D": "D", "u_D": "u_D", "wall": "walls",
@@ -122,8 +123,12 @@ class Problem:
                     "to the Problem (or dataclasses.replace(problem, ...))"
                     .format(driver, ", ".join(k + "=" for k in given),
                             ", ".join(KEYWORDS[k] for k in given)))
+            if driver != "newmark":
+                refuse_rate_dependent(problem.model, driver)
             return problem
         require_model(problem, driver)  # named after the driver called
+        if driver != "newmark":
+            refuse_rate_dependent(problem, driver)
         return cls(problem, **{KEYWORDS[k]: v for k, v in given.items()})
 
     def replace(self, **changes):

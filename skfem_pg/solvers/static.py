@@ -352,6 +352,15 @@ def padded_vector(v, n_u, N, what, rest=None):
 #: K = 2e7 mu, whatever the load) once the last increment did less than
 #: ``ROUNDOFF_ENERGY * tol`` of the step's first increment's work
 ROUNDOFF_ENERGY = 1e-3
+#: ... or once it is flat (three iterations, each within a factor 1.25 of
+#: the one before) below ``STALL_RESIDUAL`` of the reference norm, the
+#: last increment doing less than ``ROUNDOFF_ENERGY`` of the first
+#: increment's work: the rows of a stiff dilatation (U2P1C, Unl+P1C) floor
+#: at K·eps·V, which in a Newmark step near steady state is above ``tol``
+#: of the load (Poiseuille flow of water, K = 2.08 GPa, g = 2e-4 m/s²:
+#: the residual is flat at 1e-6 of the load, the last increment's work at
+#: 1e-8 of the first's)
+STALL_RESIDUAL = 1e-5
 
 
 def _small_increment(model, du, u):
@@ -374,6 +383,11 @@ def verdict(res, energy, ref, tol, small=False):
         return True, ""
     if len(res) >= 3 and rn > 0.5 * res[-2] and len(energy) > 1 \
             and energy[-1] <= ROUNDOFF_ENERGY * tol * energy[0]:
+        return True, "round-off floor"
+    if len(res) >= 4 and all(0.8 < res[-i] / res[-i - 1] < 1.25
+                             for i in (1, 2, 3)) \
+            and rn <= STALL_RESIDUAL * ref and len(energy) > 1 \
+            and energy[-1] <= ROUNDOFF_ENERGY * energy[0]:
         return True, "round-off floor"
     if len(res) >= 4 and rn > res[-2] > res[-3] and rn > 1e3 * tol * ref:
         return False, "diverging"
