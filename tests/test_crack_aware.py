@@ -295,6 +295,31 @@ def test_crack_aware_refuses_what_it_cannot_do():
     with pytest.raises(ValueError, match="vertices"):
         CrackAware(pg.FamilyBasis(pg.Particles.from_mesh(
             mesh, kind="centroids"), dim=2), STEEL)
+    with pytest.raises(ValueError, match="vc must be"):
+        CrackAware(pg.FamilyBasis(mesh, dim=2), STEEL, vc="global")
+
+
+def test_crack_aware_takes_the_local_vc_from_the_start():
+    """Issue 51: the families on the intact cells are corrected by the
+    local VC (min-norm boundary) from the start, whatever the basis' own;
+    vc="basis" keeps the basis' global 'sn' correction; a basis without
+    VC stays without.  The dofs (model.basis) are the user's basis'."""
+    mesh = shifted_grid(4, 4)
+    basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
+    local = CrackAware(basis, STEEL)
+    assert local.basis is basis and local.current is not basis
+    assert local.current.vc_report.solver == "local"
+    assert local.current.options["vc_boundary"] == "min-norm"
+    kept = CrackAware(basis, STEEL, vc="basis")
+    assert kept.current is basis and basis.options["vc_boundary"] == "sn"
+    plain = pg.FamilyBasis.from_name(mesh, "BCPBG Unl", dim=2)
+    assert CrackAware(plain, STEEL).current is plain
+    # the linear patch test on the local basis, to round-off
+    X = local.current.doflocs
+    u = (0.01 * X[0] + 0.02 * X[1]) * (np.arange(basis.N) % 2 == 0)
+    F = local.state(u)["F"]
+    assert np.abs(F[0, 0] - 1.01).max() <= 1e-12
+    assert np.abs(F[0, 1] - 0.02).max() <= 1e-12
 
 
 @pytest.mark.parametrize("vc_solver", ["auto", "local"])
@@ -357,7 +382,7 @@ def test_a_run_resumed_after_an_update_ends_where_it_would_have(tmp_path,
             model = CrackAware(basis, STEEL)
         tr, _ = pull(model, basis, 0.003, 2000.0, grip=0.0, **kw)
         return model, tr
-    whole, tr = run(checkpoint=Every(path, steps=250))
+    whole, tr = run(checkpoint=Every(path, steps=150))
     assert whole.updates >= 1
     with np.load(path) as f:
         saved_intact = f["history_crack_intact"] > 0.5

@@ -81,14 +81,16 @@ the basis on the intact cells, on the local particles of the first one
 halo exchange and the lumped mass stay.  The rebuild of a
 ``vc_solver="local"`` basis needs no communication.
 
-**Which VC correction** (issue 51, ``benchmarks/fracture_energy.py``): on
-unstructured triangles the global correction of a rebuilt basis makes
-the families along the crack faces stiff.  On the mode-I plate at h =
-1 mm, after 210 updates, the largest derivative weight was 33 times the
-intact body's and the highest frequency 17 times; the stable step
-collapsed and the run stopped.  The local correction (``VCBCPBG V5m
-Unl`` with ``vc_solver="local"``) kept them at 1.5 and 0.9 times, and
-that run completed.
+**Which VC correction** (issue 51, ``benchmarks/fracture_energy.py``;
+the default ``vc="local"``): on unstructured triangles the global
+correction of a rebuilt basis makes the families along the crack faces
+stiff.  On the mode-I plate at h = 1 mm, after 210 updates, the largest
+derivative weight was 33 times the intact body's and the highest
+frequency 17 times; the stable step collapsed and the run stopped.  The
+local correction (``vc_solver="local"``, boundary min-norm) kept them at
+1.5 and 0.9 times, and that run completed.  So the families on the
+intact cells take the local correction from the start, whatever the
+basis' own; ``vc="basis"`` keeps the basis' (global) one.
 
 The thesis' variant — connectivity kept — is the plain
 :class:`~skfem_pg.formulations.Hyperelastic` model on the same basis and
@@ -197,7 +199,7 @@ class _Crack:
     (the history and :math:`F_c` onto a new basis), :meth:`_set_basis`
     and :meth:`_n_points`."""
 
-    def _init_crack(self, basis, fraction, min_piece):
+    def _init_crack(self, basis, fraction, min_piece, vc):
         part = getattr(basis, "distributed", None)
         #: on MPI ranks: the partition and the local particles of the
         #: whole body's basis (every rebuild keeps them)
@@ -220,6 +222,25 @@ class _Crack:
         self.released_at_updates = 0.0
         self.updates, self.update_seconds, self.update_log = 0, 0.0, []
         self._n_failed = 0
+        if vc not in ("local", "basis"):
+            raise ValueError("vc must be 'local' (the local VC correction "
+                             "on the intact cells) or 'basis' (the basis' "
+                             "own), got {!r}".format(vc))
+        self.vc = vc
+        if vc == "local" and self._options.get("vc") is not None \
+                and self._options.get("vc_solver") != "local":
+            # the families on the intact cells take the local correction
+            # from the start (module docstring, "Which VC correction")
+            self._options = dict(self._options, vc_solver="local",
+                                 vc_boundary="min-norm")
+            try:
+                self._set_basis(self._basis_on(self.intact))
+            except NotImplementedError as err:
+                raise ValueError(
+                    "crack-aware families with vc='local' rebuild the basis "
+                    "with the local VC correction, which this basis' "
+                    "options do not take ({}); pass vc='basis' to keep its "
+                    "own".format(err)) from None
 
     @property
     def _mesh(self):
@@ -388,7 +409,11 @@ class CrackAware(_Crack, Hyperelastic):
 
     ``fraction``: the failed share of its points at which a cell fails;
     ``min_piece``: pieces cut off with fewer vertices fail whole (default
-    ``dim + 2``, the smallest family a VC-corrected basis takes).
+    ``dim + 2``, the smallest family a VC-corrected basis takes);
+    ``vc``: ``"local"`` (default) corrects the families on the intact
+    cells, from the start, by the local VC correction (``vc_solver=
+    "local"``, boundary min-norm), whatever the basis' own (module
+    docstring, "Which VC correction"); ``"basis"`` keeps the basis' own.
 
     ``model.basis`` stays the basis of the whole body (dofs, loads,
     Dirichlet boundaries); ``model.current`` is the basis on the intact
@@ -419,7 +444,8 @@ class CrackAware(_Crack, Hyperelastic):
 
     _gradient_key = "F"
 
-    def __init__(self, basis, material, fraction=0.5, min_piece=None):
+    def __init__(self, basis, material, fraction=0.5, min_piece=None,
+                 vc="local"):
         if not isinstance(basis, FamilyBasis) or basis.is_petrov:
             raise ValueError("crack-aware families are built for PBG family "
                              "bases, got {}".format(type(basis).__name__))
@@ -427,7 +453,7 @@ class CrackAware(_Crack, Hyperelastic):
         super().__init__(basis, material)
         self.current = basis
         self._options = basis.options
-        self._init_crack(basis, fraction, min_piece)
+        self._init_crack(basis, fraction, min_piece, vc)
 
     def _keys(self):
         return point_keys(self.current)
@@ -478,18 +504,20 @@ class CrackAwareU1SIG(_Crack, U1SIG):
     on :math:`u - u_c` [choice made here: the stabilization's accumulated
     force is dropped at an update, its energy booked as released, as the
     stabilization only controls the zero-energy modes of the new
-    families]."""
+    families].  ``fraction``, ``min_piece`` and ``vc`` as for
+    :class:`CrackAware`."""
 
     _gradient_key = "F1"
 
-    def __init__(self, basis, material, fraction=0.5, min_piece=None):
+    def __init__(self, basis, material, fraction=0.5, min_piece=None,
+                 vc="local"):
         if not isinstance(basis, FamilyBasis) or basis.is_petrov:
             raise ValueError("crack-aware families are built for PBG family "
                              "bases, got {}".format(type(basis).__name__))
         _check_crack_inputs(basis, material, fraction, "U1SIG")
         super().__init__(basis, material)
         self._options = self.u1.options
-        self._init_crack(basis, fraction, min_piece)
+        self._init_crack(basis, fraction, min_piece, vc)
 
     @classmethod
     def of(cls, basis, material):
