@@ -8,7 +8,6 @@ import skfem_pg as pg
 from skfem_pg.formulations import model_for
 from skfem_pg.materials import NeoHookeIsoVol, NewtonianFluid, NoRateError
 from skfem_pg.solvers import checkpoint, newmark
-from skfem_pg.solvers.rates import rate_material
 from skfem_pg.solvers.static import verdict
 
 RHO, K, ETA, G, H = 1e3, 2.08e9, 1e-3, 2e-4, 1e-3  # water (thesis 8.2)
@@ -109,22 +108,36 @@ def test_static_and_explicit_drivers_refuse_a_fluid():
 def test_poiseuille_start_up_follows_the_series():
     """PG Unl+P1C on 17 x 17 particles, Newmark with numerical damping:
     the middle column's v_x within 1 % of v_max of the series at t = 0.1 s
-    (measured 8.4e-3) and at 0.5 s (7.8e-3); the run's rate is unbound
-    afterwards."""
+    (measured 8.4e-3) and at 0.5 s (7.8e-3).  After the run its fields
+    can be read, and the shear stress at the final state is the viscous
+    one of the final velocities (eta dv/dy: at the wall 4 v_max eta/H)."""
     model, m, f, D, middle = _channel(16)
     y = model.basis.doflocs[1, middle]
     seen = {}
+
+    final = {}
 
     def output(t, x, v, record):
         for s in (0.1, 0.5):
             if np.isclose(t, s):
                 seen[s] = v[middle].copy()
+        final.update(x=x.copy(), v=v.copy())
     newmark(model, m, 0.5, 0.02, f_ext=f, D=D, callback=output,
             verbose=False, gamma=0.6, beta=0.3025)
     assert sorted(seen) == [0.1, 0.5]
     for t, v in seen.items():
         assert np.abs(v - _series(y, t)).max() <= 1e-2 * V_MAX, t
-    assert rate_material(model).rate is None
+    tr_x = model.initial()
+    tr_x[:] = final["x"]
+    fields = model.fields(tr_x)
+    assert set(fields) >= {"p", "Theta"}
+    state = model.state(tr_x)
+    P = model.stress(state)
+    L = model.rate_gradient(final["v"])
+    # the shear stress is eta (dv_x/dy + dv_y/dx) of the final velocities
+    # up to the bubble's share (measured 7.3 % of the largest)
+    shear = P[0, 1] - ETA * (L[0, 1] + L[1, 0])
+    assert np.abs(shear).max() <= 0.1 * ETA * np.abs(L[0, 1]).max()
 
 
 def test_pbg_unl_locks_and_does_not_flow():
@@ -172,3 +185,47 @@ def test_newton_accepts_a_flat_round_off_floor_only():
     assert verdict(falling, work, 1e-4, 1e-9)[0] is None
     assert verdict(flat, [1e-21, 1e-22, 1e-22, 1e-22], 1.2e-8,
                    1e-9)[0] is None  # the increments still do work
+
+
+def _column(method, n=10, H_col=0.1):
+    """A square column of water at rest in a box (slip walls at the sides
+    and the bottom, a free top), gravity 9.81 m/s^2 down:
+    ``(model, m, f, D)``."""
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, H_col, n + 1),
+                                    np.linspace(0, H_col, n + 1))
+    fluid = NewtonianFluid(K=K, eta=ETA)
+    if method.startswith("FEM"):
+        basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
+        along = np.zeros(basis.N, dtype=bool)
+        along[basis.nodal_dofs[0]] = True
+    else:
+        basis = pg.FamilyBasis.from_name(mesh, method, dim=2)
+        along = np.arange(basis.N) % 2 == 0
+    model = model_for(method.split()[-1], basis, fluid)
+    m = pg.lumped_mass(basis, RHO)
+    X = basis.doflocs
+    D = np.flatnonzero((np.isclose(X[1], 0) & ~along)
+                       | ((np.isclose(X[0], 0) | np.isclose(X[0], H_col))
+                          & along))
+    return model, m, np.where(~along, -m * 9.81, 0.0), D
+
+
+@pytest.mark.parametrize("method", [
+    "FEM Q1P0",
+    pytest.param("VCBCPBG V5m Unl+P1C", marks=pytest.mark.xfail(
+        strict=True, reason="issue 51: the pressure's integration is not "
+        "exact for a linear pressure (VC covers constant fields only), "
+        "and the wall particles slide down their slip walls at about g: "
+        "0.21 sqrt(gH) after 0.02 s, J <= 0 at 0.026 s (UnlP0: 0.06, "
+        "J <= 0 at 0.10 s); the thesis' diagnosis of its dam break "
+        "(8.2)")),
+])
+def test_a_column_of_water_stays_at_rest(method):
+    """Hydrostatics, the state every free-surface flow starts from: a
+    0.1 m column at rest stays at rest — after 0.02 s no velocity above
+    1 % of sqrt(gH) (FE Q1P0: measured 9.3e-4, the settling of its
+    compressibility)."""
+    model, m, f, D = _column(method)
+    tr = newmark(model, m, 0.02, 0.005, f_ext=f, D=D, verbose=False,
+                 gamma=0.6, beta=0.3025)
+    assert np.abs(tr.v).max() <= 1e-2 * np.sqrt(9.81 * 0.1)

@@ -32,8 +32,9 @@ What a driver asks of a model is :class:`~.protocol.Model`
 ``bond_based``         :class:`BondBased`: bond-based peridynamics with
                        critical-stretch breaking (PMB), the classical
                        comparator on the same particles and drivers
-``crack_aware``        :class:`CrackAware`, :class:`CrackAwareU1SIG`: Unl
-                       and U1SIG whose families stop at failed cells
+``crack_aware``        :class:`CrackAware`, :class:`CrackAwareUnlP0`,
+                       :class:`CrackAwareU1SIG`: Unl, UnlP0 and U1SIG
+                       whose families stop at failed cells
                        (beyond the thesis' 8.1)
 ``nitsche``            :class:`WeakDirichlet`: Dirichlet conditions by
                        Nitsche terms (the blended quadratic basis PG2)
@@ -52,7 +53,7 @@ from .tangents import fd_tangent
 from .history import History
 from .updated_lagrange import UpdatedLagrange
 from .bond_based import BondBased, segment_cut
-from .crack_aware import CrackAware, CrackAwareU1SIG
+from .crack_aware import CrackAware, CrackAwareU1SIG, CrackAwareUnlP0
 from .nitsche import WeakDirichlet
 
 __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
@@ -61,4 +62,5 @@ __all__ = ["linear_elasticity", "Hyperelastic", "internal_force",
            "IncompressibleP0",
            "NodalPressure", "U1SUnl", "U1SIG", "model_for", "fd_tangent",
            "History", "UpdatedLagrange", "Model", "BondBased",
-           "segment_cut", "CrackAware", "CrackAwareU1SIG", "WeakDirichlet"]
+           "segment_cut", "CrackAware", "CrackAwareU1SIG", "CrackAwareUnlP0",
+           "WeakDirichlet"]

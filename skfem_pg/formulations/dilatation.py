@@ -222,5 +222,5 @@ class MeanDilatation(Hyperelastic):
         A = self.material.tangent(state["F"]) + state["p"] * d_JFinvT(
             state["J"], state["Finv"])
         # one scatter for the pointwise and the condensed volumetric part
-        return assemble(material_tangent, self.basis, A=A,
+        return assemble(material_tangent, self.point_basis, A=A,
                         local_extra=self._volumetric_tangent(state))

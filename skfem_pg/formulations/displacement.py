@@ -204,10 +204,14 @@ class Hyperelastic:
         the unpadded flat layout ``(d, d, 1, N_q)``
         (:mod:`skfem_pg.discretization.layout`),
         so the material is evaluated only at real members."""
+        return {"F": self.deformation_gradient(u)}
+
+    def deformation_gradient(self, u):
+        r""":math:`F = I + \nabla u` at the points (a crack-aware model
+        continues it from its last update)."""
         if is_family_basis(self.basis):
-            return {"F": self.basis.interpolate(u, flat=True).grad
-                    + self._eye}
-        return {"F": self.basis.interpolate(u).grad + self._eye}
+            return self.basis.interpolate(u, flat=True).grad + self._eye
+        return self.basis.interpolate(u).grad + self._eye
 
     def rate_gradient(self, w):
         """The gradient of the nodal displacement-dof vector ``w`` at the
@@ -221,8 +225,9 @@ class Hyperelastic:
 
     def energy(self, state):
         """Stored energy :math:`\\sum w\\, W(F)` of ``state``."""
-        dx = (self.basis.flat_weights() if is_family_basis(self.basis)
-              else self.basis.dx)
+        basis = self.point_basis
+        dx = (basis.flat_weights() if is_family_basis(basis)
+              else basis.dx)
         return float(np.sum(dx * self.material.energy(state["F"])))
 
     def min_J(self, state):
@@ -234,11 +239,12 @@ class Hyperelastic:
 
     @kernel
     def internal_force(self, state):
-        return assemble(internal_force, self.basis, P=self.stress(state))
+        return assemble(internal_force, self.point_basis,
+                        P=self.stress(state))
 
     @kernel
     def tangent(self, state):
         if self.tangent_kind == "fd":
             return fd_tangent(self.basis, self.material, state["F"])
-        return assemble(material_tangent, self.basis,
+        return assemble(material_tangent, self.point_basis,
                         A=self.material.tangent(state["F"]))

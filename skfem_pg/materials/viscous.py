@@ -22,9 +22,11 @@ and the driver binds, per step, :math:`\dot F = a\,(F - F_n) + \dot F_0`
 with Newmark's :math:`a = \gamma/(\beta\Delta t)` and :math:`\dot F_0` the
 gradient of :math:`(1 - \gamma/\beta) v_n + \Delta t (1 - \gamma/2\beta)
 a_n` (:func:`skfem_pg.newmark`), so that :math:`\dot F = \nabla v_{n+1}`,
-Newmark's velocity, wherever :math:`F` is linear in the displacements.
-Outside such a run (static Newton, central differences) no rate is bound
-and the material refuses to answer.
+Newmark's velocity, wherever :math:`F` is linear in the displacements;
+after the run, the final velocity gradient stays bound (the model's
+fields and stresses at the final state).  Before a run, or after one
+that stopped early, no rate is bound and the material refuses to answer;
+static Newton and central differences refuse the model.
 """
 import numpy as np
 
@@ -46,6 +48,9 @@ class NewtonianFluid:
     :func:`~skfem_pg.newmark` on the displacement formulations (``Unl``,
     FE; they lock as the thesis found) and on the mixed ones (``UnlP0``,
     ``U2P1C``, ``Unl+P1C``), which take the volumetric part themselves.
+    On PG bases it is for flows without a pressure gradient (Poiseuille):
+    a linear pressure is not integrated exactly, and a column of water at
+    rest does not stay at rest (``tests/test_flow.py``).
 
     Examples
     --------

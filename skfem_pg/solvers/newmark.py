@@ -44,7 +44,8 @@ from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
                        stored_energy)
 from .controls import NewmarkControls
 from .problem import Problem
-from .rates import bind_newmark_rate, start_newmark_rate, unbind_rate
+from .rates import (bind_newmark_rate, end_newmark_rate,
+                    start_newmark_rate, unbind_rate)
 from .static import condensed_solver, newton_step
 
 
@@ -206,8 +207,10 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
         while stepper.t < t_end * (1 - 1e-12):
             if stepper.advance() and every is not None:
                 stepper.save(every)
-    finally:
+    except BaseException:
         unbind_rate(model)  # a viscous material's rate is this run's
+        raise
+    end_newmark_rate(model, stepper.v, stepper.step, c.beta, c.gamma)
     stepper.times["total"] = sum(stepper.times.values())
     return Trajectory(stepper.x, stepper.v, stepper.a, stepper.t,
                       stepper.hist, stepper.steps, dict(stepper.times))

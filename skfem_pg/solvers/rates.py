@@ -54,9 +54,21 @@ def bind_newmark_rate(model, h, beta, gamma, v, a):
     material.bind_rate(gamma / (beta * h), model.rate_gradient(w))
 
 
+def end_newmark_rate(model, v, h, beta, gamma):
+    r"""After a run that reached its end with the velocities ``v``: bind
+    :math:`\dot F = \frac{\gamma}{\beta h}(F - F_n) + \nabla v` (the
+    last step committed :math:`F_n`), so that the model's state at the
+    final unknowns — its fields, stresses, energy — carries the final
+    velocity gradient.  (The static drivers refuse the model whatever is
+    bound.)"""
+    material = rate_material(model)
+    if material is not None:
+        material.bind_rate(gamma / (beta * h), model.rate_gradient(v))
+
+
 def unbind_rate(model):
-    """Unbind the rate after a run: a later static run must not reuse
-    it."""
+    """Unbind the rate after a run that stopped early: its last iterate's
+    rate is no state to evaluate."""
     material = rate_material(model)
     if material is not None:
         material.bind_rate(None, None)
