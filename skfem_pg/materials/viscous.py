@@ -45,12 +45,11 @@ class NewtonianFluid:
     r"""A weakly compressible Newtonian fluid (module docstring): bulk
     modulus ``K``, dynamic viscosity ``eta``.  Give its density to
     :func:`~skfem_pg.lumped_mass`.  A stateful material: it runs in
-    :func:`~skfem_pg.newmark` on the displacement formulations (``Unl``,
-    FE; they lock as the thesis found) and on the mixed ones (``UnlP0``,
-    ``U2P1C``, ``Unl+P1C``), which take the volumetric part themselves.
-    On PG bases it is for flows without a pressure gradient (Poiseuille):
-    a linear pressure is not integrated exactly, and a column of water at
-    rest does not stay at rest (``tests/test_flow.py``).
+    :func:`~skfem_pg.newmark` on PBG UnlP0 with the local VC correction
+    (``vc_solver="local"``) and on FE Q1P0 / H1P0, which take the
+    volumetric part themselves; the formulations that cannot hold a fluid
+    are refused, each for its measured reason
+    (:func:`skfem_pg.solvers.rates.check_fluid_model`).
 
     Examples
     --------

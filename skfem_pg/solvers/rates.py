@@ -25,6 +25,54 @@ def refuse_rate_dependent(model, driver):
             "integrate it with skfem_pg.newmark".format(driver, material))
 
 
+def check_fluid_model(model):
+    """``ValueError`` naming the formulation if ``model`` carries a fluid
+    (a rate-dependent material without shear stiffness) on a formulation
+    that does not hold it (measured, ``tests/test_flow.py``): a fluid runs
+    on a mean-dilatation model — PBG UnlP0 with the local VC correction,
+    FE Q1P0 / H1P0.
+
+    * displacement formulations lock: PBG Unl does not flow in the
+      Poiseuille channel (-0.5 % of the velocity at 0.1 s), FE Q1 on
+      perturbed quadrilaterals neither (0.03 %);
+    * the nodal-pressure formulations (Unl+P1C, U2P1C) and UnlP0 with the
+      global VC correction (or none) do not hold a column of water at
+      rest: a linear pressure is not integrated exactly and the wall
+      particles slide down at about g (Unl+P1C: J <= 0 after 0.026 s, its
+      bubble creeping under the pressure gradient; UnlP0: 0.10 s).  The
+      local correction's shares (the collocation mesh's integrals of its
+      linear functions) integrate a family-constant pressure times the
+      test gradients exactly for linear pressures: UnlP0 with it keeps
+      the column within 7e-4 sqrt(gH), on perturbed quadrilaterals and
+      triangles too."""
+    material = rate_material(model)
+    if material is None or getattr(material, "mu", None) != 0.0:
+        return
+    from ..discretization.layout import is_family_basis
+    from ..formulations.dilatation import MeanDilatation
+    basis = model.basis
+    name = type(model).__name__
+    if not isinstance(model, MeanDilatation):
+        raise ValueError(
+            "a NewtonianFluid on {}: a fluid runs on a mean-dilatation "
+            "model (PBG UnlP0 with vc_solver='local', FE Q1P0 / H1P0); the "
+            "displacement formulations lock and the nodal-pressure ones "
+            "(Unl+P1C, U2P1C) do not hold a fluid at rest (skfem_pg."
+            "solvers.rates.check_fluid_model)".format(name))
+    if is_family_basis(basis):
+        report = getattr(basis, "vc_report", None)
+        if report is None or report.solver != "local":
+            raise ValueError(
+                "a NewtonianFluid on PBG UnlP0 with {}: it needs the local VC "
+                "correction (FamilyBasis.from_name(mesh, 'VCBCPBG V5m "
+                "UnlP0', dim=2, vc_solver='local')), which integrates a "
+                "linear pressure exactly; without it a column of water at "
+                "rest does not stay at rest (skfem_pg.solvers.rates."
+                "check_fluid_model)".format(
+                    "no VC correction" if report is None
+                    else "the {} VC solve".format(report.solver)))
+
+
 def start_newmark_rate(model, x, v, h, beta, gamma):
     r"""The rate at the start of a Newmark run from ``x`` with the
     velocities ``v``: the points' committed :math:`F_n` becomes that of
@@ -35,6 +83,7 @@ def start_newmark_rate(model, x, v, h, beta, gamma):
     material = rate_material(model)
     if material is None:
         return
+    check_fluid_model(model)
     material.bind_rate(gamma / (beta * h), model.rate_gradient(v))
     model.history.commit(model.state(x)["F"])
 
