@@ -210,7 +210,7 @@ def _kalthoff_winkler(out):
 def _poiseuille(out):
     # err t=0.1, err end, centre/exact, s; quick: 9 x 9 particles
     (pg,) = _rows(out, "VCBCPBG V5m UnlP0")
-    assert pg[0] <= 0.03 and pg[1] <= 0.03  # measured 1.2e-2, 1.8e-2
+    assert pg[0] <= 0.03 and pg[1] <= 0.03  # measured 8.2e-3, 1.8e-2
     assert abs(pg[2] - 1.0) <= 0.03  # measured +1.5 %
 
 

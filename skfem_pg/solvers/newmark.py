@@ -350,8 +350,9 @@ def _step(run, controls, start_state, t, h, solver, solvers, times):
     N = x.shape[0]
     c = 1.0 / (beta * h * h)
     u_tilde = x[:n_u] + h * v + h * h * (0.5 - beta) * a
-    start = x.copy()
-    start[:n_u] = u_tilde + beta * h * h * a  # constant acceleration
+    start = x.copy()  # the last unknowns (NewmarkControls.predictor)
+    if controls.predictor == "acceleration":
+        start[:n_u] = u_tilde + beta * h * h * a  # constant acceleration
     uD = uD_of(t + h)
     held = held.copy()
     for _ in range(max_passes):
