@@ -111,7 +111,7 @@ SCRIPTS = [
     ("poiseuille", ["demos/poiseuille.py"],
      "thesis 8.2 / Fig. 8.2: Poiseuille start-up of water, PG UnlP0 with "
      "the local VC beside FE Q1P0, against the analytic series; VTU "
-     "series", "25 s", 25),
+     "series", "12 s", 12),
     ("cook_mpi", ["demos/cook_mpi.py"],
      "3-D Cook on 1 or 2 MPI ranks (`mpirun -n 2`): per-rank timings, "
      "Newton and KSP iterations, difference to the serial run (serial "
@@ -135,7 +135,7 @@ SCRIPTS = [
      "thesis 8.2: a column of water at rest (2-D, 3-D, perturbed), "
      "Poiseuille's start-up, the dam break against Martin & Moyce; PG "
      "UnlP0 with the local VC beside FE Q1P0/H1P0 and the refused "
-     "formulations", "3 min", 180),
+     "formulations", "2 min", 130),
     ("fracture_energy", ["benchmarks/fracture_energy.py"],
      "elastic–brittle fracture: (W_int − stored − released) / W_int of PG "
      "kept and crack-aware (global and local VC) and PMB on the mode-I "
