@@ -69,13 +69,25 @@ def test_fluid_parameters_and_refusals():
 PG = "VCBCPBG V5m UnlP0"
 
 
-def _channel(n, method=PG, vc_solver="local"):
-    """The Poiseuille channel of demos/poiseuille.py: ``(model, m, f, D,
-    middle)``."""
-    mesh = fem.MeshQuad.init_tensor(np.linspace(0, H, n + 1),
-                                    np.linspace(0, H, n + 1))
-    basis = pg.FamilyBasis.from_name(mesh, method, dim=2,
-                                     vc_solver=vc_solver)
+def _square(L, n, perturb=0.0, triangles=False):
+    """An n x n grid on the square of side ``L``, its interior nodes moved
+    by up to ``perturb`` spacings (quadrilaterals or triangles)."""
+    axis = np.linspace(0, L, n + 1)
+    quads = fem.MeshQuad.init_tensor(axis, axis)
+    p = quads.p.copy()
+    inner = np.all((p > 1e-12) & (p < L - 1e-12), axis=0)
+    p[:, inner] += perturb * L / n * np.random.default_rng(1).uniform(
+        -1, 1, (2, inner.sum()))
+    if triangles:
+        return fem.MeshTri(p, fem.MeshTri.init_tensor(axis, axis).t)
+    return fem.MeshQuad(p, quads.t)
+
+
+def _channel(n, method=PG, vc_solver="local", perturb=0.0):
+    """The Poiseuille channel of demos/poiseuille.py, its interior nodes
+    moved by up to ``perturb`` spacings: ``(model, m, f, D, middle)``."""
+    basis = pg.FamilyBasis.from_name(_square(H, n, perturb), method,
+                                     dim=2, vc_solver=vc_solver)
     model = model_for(method.split()[-1], basis,
                       NewtonianFluid(K=K, eta=ETA))
     m = pg.lumped_mass(basis, RHO)
@@ -198,15 +210,7 @@ def _column(method, perturb=0.0, triangles=False, n=10, H_col=0.1):
     and the bottom, a free top), gravity 9.81 m/s^2 down, on a grid whose
     interior nodes are moved by up to ``perturb`` spacings:
     ``(model, m, f, D)``."""
-    mesh = fem.MeshQuad.init_tensor(np.linspace(0, H_col, n + 1),
-                                    np.linspace(0, H_col, n + 1))
-    p = mesh.p.copy()
-    inner = np.all((p > 1e-12) & (p < H_col - 1e-12), axis=0)
-    p[:, inner] += perturb * H_col / n * np.random.default_rng(1).uniform(
-        -1, 1, (2, inner.sum()))
-    mesh = (fem.MeshTri(p, fem.MeshTri.init_tensor(
-        np.linspace(0, H_col, n + 1), np.linspace(0, H_col, n + 1)).t)
-        if triangles else fem.MeshQuad(p, mesh.t))
+    mesh = _square(H_col, n, perturb, triangles)
     fluid = NewtonianFluid(K=K, eta=ETA)
     if method.startswith("FEM"):
         basis = fem.Basis(mesh, fem.ElementVector(fem.ElementQuad1()))
@@ -249,24 +253,8 @@ def test_newmark_starts_newton_from_the_last_unknowns():
     constant-acceleration prediction, which breaks incompressibility at
     the held walls, it diverged: measured 40 cuts, 48 steps, 7x the
     time."""
-    n = 8
-    mesh = fem.MeshQuad.init_tensor(np.linspace(0, H, n + 1),
-                                    np.linspace(0, H, n + 1))
-    p = mesh.p.copy()
-    inner = np.all((p > 1e-12) & (p < H - 1e-12), axis=0)
-    p[:, inner] += 0.3 * H / n * np.random.default_rng(1).uniform(
-        -1, 1, (2, inner.sum()))
-    basis = pg.FamilyBasis.from_name(fem.MeshQuad(p, mesh.t), PG, dim=2,
-                                     vc_solver="local")
-    model = model_for("UnlP0", basis, NewtonianFluid(K=K, eta=ETA))
-    m = pg.lumped_mass(basis, RHO)
-    X = basis.doflocs
-    along = np.arange(basis.N) % 2 == 0
-    D = np.flatnonzero(np.isclose(X[1], 0) | np.isclose(X[1], H)
-                       | ((np.isclose(X[0], 0) | np.isclose(X[0], H))
-                          & ~along))
-    tr = newmark(model, m, 0.2, 0.02, f_ext=np.where(along, m * G, 0.0),
-                 D=D, verbose=False)
+    model, m, f, D, _ = _channel(8, perturb=0.3)
+    tr = newmark(model, m, 0.2, 0.02, f_ext=f, D=D, verbose=False)
     assert tr.steps == 10 and tr.history[-1]["cuts"] == 0
     with pytest.raises(ValueError, match="predictor"):
         newmark(model, m, 0.2, 0.02, D=D, verbose=False, predictor="none")

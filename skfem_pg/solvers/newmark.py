@@ -44,7 +44,7 @@ from .dynamics import (DynamicsError, EnergyBalance, Progress, Recorder,
                        stored_energy)
 from .controls import NewmarkControls
 from .problem import Problem
-from .rates import (bind_newmark_rate, end_newmark_rate,
+from .rates import (bind_newmark_rate, bind_velocity_rate,
                     start_newmark_rate, unbind_rate)
 from .static import condensed_solver, newton_step
 
@@ -210,7 +210,7 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
     except BaseException:
         unbind_rate(model)  # a viscous material's rate is this run's
         raise
-    end_newmark_rate(model, stepper.v, stepper.step, c.beta, c.gamma)
+    bind_velocity_rate(model, stepper.v, stepper.step, c.beta, c.gamma)
     stepper.times["total"] = sum(stepper.times.values())
     return Trajectory(stepper.x, stepper.v, stepper.a, stepper.t,
                       stepper.hist, stepper.steps, dict(stepper.times))

@@ -123,13 +123,13 @@ class Problem:
                     "to the Problem (or dataclasses.replace(problem, ...))"
                     .format(driver, ", ".join(k + "=" for k in given),
                             ", ".join(KEYWORDS[k] for k in given)))
-            if driver != "newmark":
-                refuse_rate_dependent(problem.model, driver)
-            return problem
-        require_model(problem, driver)  # named after the driver called
+            out = problem
+        else:
+            require_model(problem, driver)  # named after the driver called
+            out = cls(problem, **{KEYWORDS[k]: v for k, v in given.items()})
         if driver != "newmark":
-            refuse_rate_dependent(problem, driver)
-        return cls(problem, **{KEYWORDS[k]: v for k, v in given.items()})
+            refuse_rate_dependent(out.model, driver)
+        return out
 
     def replace(self, **changes):
         """A copy with ``changes`` (fields of :class:`Problem`)."""

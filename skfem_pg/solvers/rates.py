@@ -1,8 +1,9 @@
 """Rate-dependent materials in the drivers: the viscous stress of a
 :class:`~skfem_pg.materials.NewtonianFluid` needs the rate of F, which
 only an integrator with velocities can give.  :func:`skfem_pg.newmark`
-binds Newmark's rate at the start (:func:`start_newmark_rate`) and per
-step (:func:`bind_newmark_rate`); the other
+binds Newmark's rate at the start (:func:`start_newmark_rate`), per
+step (:func:`bind_newmark_rate`) and at the end
+(:func:`bind_velocity_rate`); the other
 drivers refuse such a model by name (:func:`refuse_rate_dependent`)."""
 import numpy as np
 
@@ -81,14 +82,13 @@ def start_newmark_rate(model, x, v, h, beta, gamma):
     r"""The rate at the start of a Newmark run from ``x`` with the
     velocities ``v``: the points' committed :math:`F_n` becomes that of
     ``x`` and :math:`\dot F = \frac{\gamma}{\beta h}(F - F_n) + \nabla
-    v`, which is :math:`\nabla v` at ``x`` (a rate factor that is not
-    zero keeps a bubble's local system regular with a fluid's zero shear
-    modulus).  Does nothing for a rate-independent model."""
-    material = rate_material(model)
-    if material is None:
+    v`, which is :math:`\nabla v` at ``x`` (with a rate factor that is
+    not zero, the tangent at the start keeps its viscous part).  Does
+    nothing for a rate-independent model."""
+    if rate_material(model) is None:
         return
     check_fluid_model(model)
-    material.bind_rate(gamma / (beta * h), model.rate_gradient(v))
+    bind_velocity_rate(model, v, h, beta, gamma)
     model.history.commit(model.state(x)["F"])
 
 
@@ -107,13 +107,13 @@ def bind_newmark_rate(model, h, beta, gamma, v, a):
     material.bind_rate(gamma / (beta * h), model.rate_gradient(w))
 
 
-def end_newmark_rate(model, v, h, beta, gamma):
-    r"""After a run that reached its end with the velocities ``v``: bind
-    :math:`\dot F = \frac{\gamma}{\beta h}(F - F_n) + \nabla v` (the
-    last step committed :math:`F_n`), so that the model's state at the
-    final unknowns — its fields, stresses, energy — carries the final
-    velocity gradient.  (The static drivers refuse the model whatever is
-    bound.)"""
+def bind_velocity_rate(model, v, h, beta, gamma):
+    r"""Bind :math:`\dot F = \frac{\gamma}{\beta h}(F - F_n) + \nabla
+    v`, which is :math:`\nabla v` at the committed state: at the start
+    of a run (:func:`start_newmark_rate`) and after one that reached its
+    end, so that the model's state at the final unknowns — its fields,
+    stresses, energy — carries the final velocity gradient.  (The static
+    drivers refuse the model whatever is bound.)"""
     material = rate_material(model)
     if material is not None:
         material.bind_rate(gamma / (beta * h), model.rate_gradient(v))
