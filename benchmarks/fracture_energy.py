@@ -20,8 +20,15 @@ triangles and on Kalthoff–Winkler's square grid:
    spacing h), and the failed band's width;
 2. PG kept at h = 2 mm with the stable step scaled by 1, 1/2, 1/4, 1/8:
    the order of what is left;
-3. Kalthoff–Winkler (the demo's setting) to 60 µs: PG kept and crack-aware
-   (local and global VC) at 4 mm, PMB at 2 mm.
+3. the mode-I plate pulled slower (1 m/s each grip, to 300 µs), PG kept
+   and crack-aware at h = 2 and 1 mm, with the crack-band criterion and
+   with the nonlocal one
+   (:class:`~skfem_pg.materials.NonlocalStrainDamage`, radius 4 mm,
+   its critical strain from G0): is the released energy per crack
+   length, and the initiation, independent of h?
+4. Kalthoff–Winkler (the demo's setting) to 60 µs: PG kept and crack-aware
+   (local and global VC) at 4 mm, PMB at 2 mm, PG kept with the nonlocal
+   criterion at 2 mm.
 
 A run that stops is reported with the driver's reason.  (Why the
 crack-aware run with the global VC stops on the plate at h = 1 mm: the
@@ -31,7 +38,7 @@ times the intact body's and the highest frequency 17 times; rebuilt
 with the local VC 1.5 and 0.9 times, without VC 0.85 and 0.83 times.)
 
 Run: ``python benchmarks/fracture_energy.py --results benchmarks/README.md``
-(about 5 min on 2 cores).
+(about 15 min on 2 cores).
 """
 import time
 
@@ -44,23 +51,30 @@ import skfem_pg as pg
 from skfem_pg.formulations import BondBased, CrackAware, model_for, \
     segment_cut
 from skfem_pg.formulations.crack_aware import cell_failure
-from skfem_pg.materials import CriticalStrainDamage, J2Plasticity
+from skfem_pg.materials import (CriticalStrainDamage, J2Plasticity,
+                                NonlocalStrainDamage)
 from skfem_pg.solvers import DynamicsError, ExplicitControls
 
 #: N, mm, s: maraging steel (Kalthoff–Winkler, demos/kalthoff_winkler.py)
 E, NU, G0, RHO = 190e3, 0.3, 22.17, 8e-9
 SAFETY = ExplicitControls().safety  # the default stable-step factor
+RADIUS = 4.0  # mm: the nonlocal criterion's radius
 
 
-def model_of(kind, mesh, h):
+def model_of(kind, mesh, h, radius=None):
     """``(basis, model)``: PG Unl (``VCBCPBG V5sn Unl``) kept or
     crack-aware (its default local VC; ``crack-aware, global VC``: the
     basis' own, ``vc="basis"``) with the crack-band brittle criterion of
-    spacing ``h``, or PMB."""
+    spacing ``h`` (with ``radius``: the nonlocal criterion of that radius
+    instead), or PMB."""
     if kind == "PMB":
         basis = pg.FamilyBasis(mesh, dim=2)
         return basis, BondBased(basis, E, G0=G0, plane="strain")
-    law = CriticalStrainDamage.from_fracture_energy(G0, E / (1 - NU ** 2), h)
+    if radius is None:
+        law = CriticalStrainDamage.from_fracture_energy(
+            G0, E / (1 - NU ** 2), h)
+    else:
+        law = NonlocalStrainDamage.from_fracture_energy(G0, E, NU, radius)
     steel = J2Plasticity.from_young(E, NU, 1e9, damage=law)  # elastic
     basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
     if kind.startswith("crack"):
@@ -87,22 +101,26 @@ HEADER = ["run", "particles", "steps", "(W_int − stored − released)/W_int",
           "drivers' balance", "released/W_int", "s"]
 
 
-def integrate(model, basis, **kw):
+def integrate(model, basis, t_end=6e-5, **kw):
     """``(basis, trajectory or the DynamicsError that stopped it,
-    seconds)`` of central differences to 60 µs."""
+    seconds)`` of central differences to ``t_end``."""
     t0 = time.perf_counter()
     try:
-        tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), 6e-5,
+        tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), t_end,
                                    verbose=False, **kw)
     except DynamicsError as err:
         tr = err
     return basis, tr, time.perf_counter() - t0
 
 
-def mode_one(kind, h, safety=SAFETY):
+def mode_one(kind, h, safety=SAFETY, speed=5000.0, t_end=6e-5,
+             radius=None, **kw):
+    """The plate's grips pulled apart at ``speed`` (mm/s) each to
+    ``t_end``: ``(basis, trajectory or DynamicsError, seconds, model,
+    mesh)``; ``kw`` to the driver."""
     mesh = pg.meshing.from_geo(pg.meshing.geo_path("plate_slot.geo"),
                                size=h)
-    basis, model = model_of(kind, mesh, h)
+    basis, model = model_of(kind, mesh, h, radius)
     X = basis.doflocs
     y = np.arange(basis.N) % 2 == 1
     grip = getattr(model, "horizon", 0.0)  # PMB: held by a layer
@@ -111,10 +129,10 @@ def mode_one(kind, h, safety=SAFETY):
 
     def u_D(t):
         u = np.zeros(basis.N)
-        u[top], u[bottom] = 5000.0 * t, -5000.0 * t
+        u[top], u[bottom] = speed * t, -speed * t
         return u
-    return integrate(model, basis, D=np.concatenate([top, bottom]),
-                     u_D=u_D, safety=safety) + (model, mesh)
+    return integrate(model, basis, t_end, D=np.concatenate([top, bottom]),
+                     u_D=u_D, safety=safety, **kw) + (model, mesh)
 
 
 def crack_measures(model, mesh, tr, h):
@@ -149,7 +167,16 @@ def crack_measures(model, mesh, tr, h):
             "" if band is None else "{:.1f}".format(band)]
 
 
-def kalthoff_winkler(kind, dx):
+def first_failure(tr):
+    """The time (µs) of the first record with released energy, a table
+    cell (records every 10 steps: to 2 µs at h = 2 mm, 1 µs at 1 mm)."""
+    if isinstance(tr, DynamicsError):
+        return ""
+    t = [r["t"] for r in tr.history if r.get("fracture", 0.0) > 0]
+    return "{:.0f}".format(1e6 * t[0]) if t else "none"
+
+
+def kalthoff_winkler(kind, dx, radius=None):
     """The demo's plate (100 x 200 mm, notches 50 mm long at y = ±25 mm,
     the hit edge moved at 16.5 m/s) to 60 µs."""
     mesh = fem.MeshQuad.init_tensor(
@@ -167,7 +194,7 @@ def kalthoff_winkler(kind, dx):
         c = mesh.p[:, mesh.t].mean(axis=1)
         notch = (np.abs(np.abs(c[1]) - y_notch) < dx / 2) & (c[0] < 50)
         basis, model = model_of(kind, fem.MeshQuad(mesh.p, mesh.t[:, ~notch]),
-                                dx)
+                                dx, radius)
     X = basis.doflocs
     hit = np.flatnonzero((X[0] < 3 * dx - 1e-9) & (np.abs(X[1]) < y_notch)
                          & (np.arange(basis.N) % 2 == 0))
@@ -176,7 +203,15 @@ def kalthoff_winkler(kind, dx):
         u = np.zeros(basis.N)
         u[hit] = 16500.0 * t
         return u
-    return integrate(model, basis, D=hit, u_D=u_D)
+    basis, tr, s = integrate(model, basis, D=hit, u_D=u_D)
+    if isinstance(model, BondBased):  # particles more than a third broken
+        failed = int((model.damage() > 1 / 3).sum())
+    elif isinstance(model, CrackAware):
+        failed = int((~model.intact).sum())
+    else:
+        failed = int((cell_failure(basis, basis.particles.mesh.t,
+                                   model.failed()) >= 0.5).sum())
+    return basis, tr, s, failed
 
 
 def main(results=None):
@@ -195,6 +230,25 @@ def main(results=None):
             + markdown_table(HEADER + ["crack (mm)", "released / (G0 L)",
                                        "band / h"], rows))
     rows = []
+    for radius in (None, RADIUS):
+        for kind in ("kept", "crack-aware"):
+            for h in (2.0, 1.0):
+                basis, tr, s, model, mesh = mode_one(
+                    kind, h, speed=1000.0, t_end=3e-4, radius=radius,
+                    output_every=10)
+                rows.append(row("{}, {}, h = {:g} mm".format(
+                    kind, "crack band" if radius is None else
+                    "nonlocal R = {:g} mm".format(radius), h), basis, tr, s)
+                    + [first_failure(tr)]
+                    + crack_measures(model, mesh, tr, h))
+                print(" | ".join(rows[-1]), flush=True)
+    text += ("\n\nThe slower pull (1 m/s each grip, 300 µs): the crack band "
+             "against the nonlocal criterion (radius {:g} mm), the first "
+             "failure's time:\n\n".format(RADIUS)
+             + markdown_table(HEADER + ["first failure (µs)", "crack (mm)",
+                                        "released / (G0 L)", "band / h"],
+                              rows))
+    rows = []
     for scale in (1.0, 0.5, 0.25, 0.125):
         basis, tr, s = mode_one("kept", 2.0, SAFETY * scale)[:3]
         rows.append(row("kept, h = 2 mm, step x {:g}".format(scale), basis,
@@ -203,13 +257,18 @@ def main(results=None):
     text += ("\n\nThe step scaled (PG kept, h = 2 mm):\n\n"
              + markdown_table(HEADER, rows))
     rows = []
-    for kind, dx in (("kept", 4.0), ("crack-aware", 4.0),
-                     ("crack-aware, global VC", 4.0), ("PMB", 2.0)):
-        basis, tr, s = kalthoff_winkler(kind, dx)
-        rows.append(row("{}, dx = {:g} mm".format(kind, dx), basis, tr, s))
+    for kind, dx, radius in (("kept", 4.0, None), ("crack-aware", 4.0, None),
+                             ("crack-aware, global VC", 4.0, None),
+                             ("PMB", 2.0, None), ("kept", 2.0, RADIUS)):
+        basis, tr, s, failed = kalthoff_winkler(kind, dx, radius)
+        rows.append(row("{}, dx = {:g} mm{}".format(
+            kind, dx, "" if radius is None else
+            ", nonlocal R = {:g} mm".format(radius)), basis, tr, s)
+            + [str(failed)])
         print(" | ".join(rows[-1]), flush=True)
     text += ("\n\nKalthoff–Winkler on the square grid, 60 µs, the stable "
-             "step:\n\n" + markdown_table(HEADER, rows))
+             "step; the failed cells (PMB: particles more than a third "
+             "broken):\n\n" + markdown_table(HEADER + ["failed"], rows))
     print(text)
     if results:
         update_results(results, "fracture_energy", text)

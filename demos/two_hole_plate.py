@@ -33,8 +33,9 @@ families along a fresh crack grow, and the stable step fell within 0.1
 ms of the first failure from 1.1e-7 to 7e-10 s (Unl) and to 2.7e-9 s
 (U1SIG) (``sn``: 5.6e-8 and 4.5e-8 s).
 Prints, per model, when the first point fails and where, the peak bottom
-force and stored energy and when they fall, the failed share, the energy
-balance and the run time.  Writes ``out/two_hole_plate.png`` (damage on
+force and stored energy and when they fall, the angle at which the outer
+bridges tear (the thesis' figure: about 45 degrees), the failed share,
+the energy balance and the run time.  Writes ``out/two_hole_plate.png`` (damage on
 the deformed plate at four times per model, and the bottom force, stored
 and released energy over time) and a VTU series per model
 (``out/two_hole_plate/<model>/step_NNN.vtu`` with ``.pvd``: u, damage).
@@ -113,6 +114,31 @@ def damage_per_node(model, basis, mesh):
     return total / np.maximum(count, 1)
 
 
+def bridge_angles(mesh, D):
+    """The angle (degrees from the x axis, in [0, 90]) at which each
+    outer bridge — left of the lower hole (from the edge x = 0 to the hole
+    at x = 4, around y = 17), right of the upper one (x = 16 to 20, around
+    y = 23) — has torn: the line from the mean position of its failed
+    vertices (``D >= 0.5``) by the plate's edge (within 1.5 mm) to that
+    by the hole (within 1.5 mm); ``nan`` where either has none.  Across
+    the bridge, perpendicular to the pull, is 0; the thesis' Fig. 8.1
+    shows about 45."""
+    x, y = mesh.p
+    failed = D >= 0.5
+    out = []
+    for yc, edge, hole in ((17.0, x < 1.5, (x > 2.5) & (x < 4.5)),
+                           (23.0, x > 18.5, (x > 15.5) & (x < 17.5))):
+        near = failed & (np.abs(y - yc) < 6)
+        if not (near & edge).any() or not (near & hole).any():
+            out.append(np.nan)
+            continue
+        a, b = mesh.p[:, near & edge].mean(axis=1), \
+            mesh.p[:, near & hole].mean(axis=1)
+        out.append(float(np.degrees(np.arctan2(abs(b[1] - a[1]),
+                                               abs(b[0] - a[0])))))
+    return out
+
+
 def run(mesh, method, t_end, snapshots, folder, outputs):
     """Pull the plate with ``method`` until ``t_end``: at every output
     (``outputs`` steps apart; ``None``: the driver's about 20) the bottom
@@ -154,7 +180,9 @@ def run(mesh, method, t_end, snapshots, folder, outputs):
     seconds = time.perf_counter() - t0
     return dict(method=method, curve=np.array(curve), shots=shots,
                 first=first[0] if first else None, trajectory=tr,
-                seconds=seconds, basis=basis, model=model)
+                seconds=seconds, basis=basis, model=model,
+                bridges=bridge_angles(mesh, damage_per_node(model, basis,
+                                                            mesh)))
 
 
 def report(r):
@@ -177,6 +205,10 @@ def report(r):
           .format(c[peak_f, 1], c[peak_f, 0], c[-1, 1]))
     print("  stored energy: peak {:.4g} N mm at t = {:.3g} s, last {:.4g}"
           .format(c[peak_w, 2], c[peak_w, 0], c[-1, 2]))
+    print("  the outer bridges tear at {} (left) and {} (right) to the x "
+          "axis (thesis: about 45 degrees)".format(*(
+              "not torn" if np.isnan(a) else "{:.0f} degrees".format(a)
+              for a in r["bridges"])))
     print("  released by failure {:.4g} N mm; dissipation {:.4g}; energy "
           "balance {:.2e}".format(c[-1, 3], last.get("dissipation", np.nan),
                                   last["relative_error"]))

@@ -282,8 +282,8 @@ def test_cells_fail_from_their_failed_points():
 
 def test_crack_aware_refuses_what_it_cannot_do():
     mesh = shifted_grid(4, 4)
-    with pytest.raises(ValueError, match="mesh' family rule"):
-        CrackAware(pg.FamilyBasis(mesh, dim=2, families="nearest"), STEEL)
+    with pytest.raises(ValueError, match="'nearest' family rule"):
+        CrackAware(pg.FamilyBasis(mesh, dim=2, families="horizon"), STEEL)
     with pytest.raises(ValueError, match="no damage law"):
         CrackAware(pg.FamilyBasis(mesh, dim=2), NeoHooke(lam=1.0, mu=2.0))
     with pytest.raises(ValueError, match="no damage law"):
@@ -346,6 +346,42 @@ def test_crack_aware_strip_separates_where_the_thesis_variant_holds(vc):
     last = tr.history[-1]
     assert 0 < last["fracture"] < last["dissipation"]
     assert (model.current.vc_report.solver == "local") == (vc == "local")
+
+
+def test_nearest_families_stay_on_their_side_of_removed_cells():
+    """Particles of a subset of the cells (a crack-aware rebuild): the
+    nearest-neighbour families are taken among the particles the cells
+    connect, so none reaches across a removed row, while the Euclidean
+    neighbours of the same particles do; away from the gap a family
+    before the pairing is the Euclidean one (the 3 x 3 stencil)."""
+    mesh = fem.MeshQuad.init_tensor(np.linspace(0, 6, 7), np.linspace(0, 7, 8))
+    c = mesh.p[:, mesh.t].mean(axis=1)
+    kept = np.flatnonzero(np.abs(c[1] - 3.5) > 0.1)  # the row y in (3, 4)
+    p = pg.Particles.from_mesh(mesh, elements=kept)
+    fam = pg.families.nearest(p, 6)
+    k = np.repeat(fam.masters, fam.sizes)
+    below = mesh.p[1] < 3.5
+    assert not np.any(below[k] != below[fam.members])
+    euclid = pg.families.nearest(pg.Particles(p.x, p.volumes), 6)
+    k = np.repeat(euclid.masters, euclid.sizes)
+    assert np.any(below[k] != below[euclid.members])
+    inner = int(np.argmin(np.hypot(p.x[0] - 3, p.x[1] - 1)))
+    own, near = (pg.families.nearest(q, 6, pairwise=False) for q in (
+        p, pg.Particles(p.x, p.volumes)))
+    assert sorted(own.members[own.offsets[inner]:own.offsets[inner + 1]]) \
+        == sorted(near.members[near.offsets[inner]:near.offsets[inner + 1]])
+    assert own.sizes[own.masters == inner][0] == 9
+
+
+def test_crack_aware_strip_separates_with_nearest_neighbour_families():
+    """The notched strip with the kNN families (``families="nearest"``):
+    rebuilt among the intact cells' particles, no family spans the crack
+    and the strip comes apart as with the mesh rule."""
+    mesh, y_notch = strip(6, notch_cells=True)
+    basis = pg.FamilyBasis(mesh, dim=2, families="nearest")
+    model = CrackAware(basis, STEEL)
+    tr, first = pull(model, basis, 0.02, 2000.0, grip=0.0)
+    _assert_separated(model, basis, mesh, y_notch, tr)
 
 
 def _assert_separated(model, basis, mesh, y_notch, tr):

@@ -33,6 +33,8 @@ systems.
 ``assembly``, ``forms``    batched assembly; the fast-path decorators
 ``loads``                  tractions, stress and body loads on FE and PG bases
 ``coefficients``           piecewise (per-cell) coefficients at the members
+``nonlocal_mean``          :class:`~skfem_pg.discretization.nonlocal_mean.
+                           NonlocalAverage`: bell means over a model's points
 =========================  ====================================================
 """
 from .particles import Particles

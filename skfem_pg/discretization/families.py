@@ -332,6 +332,12 @@ def nearest(particles, n, pairwise=True, min_size=None, ties=True,
     takes exactly ``n`` (the order among equidistant particles is then
     arbitrary).
 
+    On particles of a subset of a mesh's cells
+    (``Particles.from_mesh(mesh, elements=...)``: what a crack-aware
+    update collocates) the neighbours are taken among the particles the
+    cells connect within a few rings, so that no family reaches across
+    removed cells.
+
     >>> import numpy as np, skfem as fem, skfem_pg as pg
     >>> m = fem.MeshQuad.init_tensor(*(2 * [range(5)]))
     >>> p = pg.Particles.from_mesh(m)
@@ -349,6 +355,17 @@ def nearest(particles, n, pairwise=True, min_size=None, ties=True,
         raise FamilyError("need 1 <= n < {} (active particles), got {}"
                           .format(len(act), n))
     tol = _positive_number(tie_tolerance, "tie tolerance") if ties else 0.0
+    N = particles.n
+    d = particles.dim
+    if particles.elements is not None and particles.mesh is not None \
+            and particles.kind == "vertices":
+        # a body of a subset of the cells (a crack-aware rebuild): the
+        # neighbours among the particles its cells connect
+        A = _nearest_in_cells(particles, act, n, tol)
+        if pairwise:
+            A = (A + A.T).tocsr()
+        return _complete(particles.x, A, act,
+                         d + 2 if min_size is None else min_size)
     pts = particles.x[:, act].T
     k = n + 1
     while True:  # at most log2(#particles) rounds: k doubles
@@ -364,14 +381,53 @@ def nearest(particles, n, pairwise=True, min_size=None, ties=True,
         k = kq
     rows = np.repeat(act, keep.sum(axis=1))
     cols = act[idx[keep]]
-    N = particles.n
     A = sp.csr_matrix((np.ones(len(rows), dtype=bool), (rows, cols)),
                       shape=(N, N))
     if pairwise:
         A = (A + A.T).tocsr()
-    d = particles.dim
     return _complete(particles.x, A, act,
                      d + 2 if min_size is None else min_size)
+
+
+def _nearest_in_cells(particles, act, n, tol, max_rings=6):
+    """The ``n`` nearest (with ties within ``tol``) of each active
+    particle among those its element subset connects within a few rings
+    of cells (grown ring by ring, at most ``max_rings``, until every
+    particle has ``n`` candidates or its piece has no more): no family
+    reaches across a gap of removed cells, as the Euclidean nearest
+    neighbours would."""
+    mesh, N = particles.mesh, particles.n
+    t = mesh.t[:, np.asarray(mesh.normalize_elements(particles.elements))]
+    E = sp.csr_matrix((np.ones(t.size, dtype=bool),
+                       (t.ravel(), np.tile(np.arange(t.shape[1]),
+                                           t.shape[0]))),
+                      shape=(N, t.shape[1]))
+    ring = (E @ E.T).astype(bool).tocsr()
+    C = ring
+    for _ in range(max_rings - 1):  # the next ring of the short rows
+        short = act[C.getnnz(axis=1)[act] < n + 1]
+        if not short.size:
+            break
+        S = sp.csr_matrix((np.ones(short.size, dtype=bool), (short, short)),
+                          shape=(N, N))
+        grown = (C + S @ C @ ring).astype(bool).tocsr()
+        if grown.nnz == C.nnz:
+            break  # their pieces are exhausted
+        C = grown
+    C = C[act].tocoo()
+    i, j = act[C.row], C.col
+    dist = np.linalg.norm(particles.x[:, i] - particles.x[:, j], axis=0)
+    order = np.lexsort((dist, i))
+    i, j, dist = i[order], j[order], dist[order]
+    start = np.searchsorted(i, i, side="left")
+    rank = np.arange(i.size) - start
+    count = np.bincount(i, minlength=N)
+    # the distance of the n-th neighbour (rank n: the particle itself is
+    # rank 0), or of the last candidate of a smaller piece
+    nth = dist[start + np.minimum(n, count[i] - 1)]
+    keep = dist <= nth * (1.0 + tol) if tol > 0 else rank <= n
+    return sp.csr_matrix((np.ones(int(keep.sum()), dtype=bool),
+                          (i[keep], j[keep])), shape=(N, N))
 
 
 def _positive_number(value, what):

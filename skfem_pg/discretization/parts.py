@@ -161,11 +161,12 @@ class FamilyRule(Part):
             return ("families={} on MPI: a rank builds its families from "
                     "the mesh (rule 'mesh'), its nearest particles (rule "
                     "'nearest') or takes them given".format(self.describe()))
-        if capability == "crack_rebuild" and (self.given or self.parameters
-                                              or self.rule != "mesh"):
+        if capability == "crack_rebuild" and (
+                self.given or self.rule not in ("mesh", "nearest")
+                or (self.rule == "mesh" and self.parameters)):
             return ("crack-aware families rebuild the families from the "
-                    "intact cells: the basis needs the 'mesh' family rule, "
-                    "got {}".format(self.describe()))
+                    "intact cells: the basis needs the 'mesh' or the "
+                    "'nearest' family rule, got {}".format(self.describe()))
         return None
 
 

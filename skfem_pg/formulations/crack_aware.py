@@ -39,8 +39,11 @@ master):
   closed surface;
 * **the families, shape functions, bond and VC corrections are rebuilt**
   with the basis' own options on these particles; the mesh rule then
-  builds the families from the intact cells, so no family spans a failed
-  cell.  The VC correction is the global solve of the basis (the cost of an
+  builds the families from the intact cells, and the nearest-neighbour
+  rule (``families="nearest"``, the kNN recipe) takes the nearest among
+  the particles the intact cells connect
+  (:func:`~skfem_pg.discretization.families.nearest`), so no family spans
+  a failed cell.  The VC correction is the global solve of the basis (the cost of an
   update, :attr:`CrackAware.update_seconds`); it runs only in steps in
   which cells fail;
 * **semi-total Lagrangian gradients**: after an update at :math:`u_c`,
@@ -142,7 +145,7 @@ class _CrackHistory(History):
     the point arrays are restored."""
 
     def __init__(self, material, model):
-        super().__init__(material)
+        super().__init__(material, lambda: model.point_basis)
         self._model = model
 
     def save(self):

@@ -135,7 +135,8 @@ class MeanDilatation(Hyperelastic):
         volumetric energy loses its failed share in tension (module
         docstring)."""
         if getattr(material, "stateful", False):
-            self.material = History(material.isochoric(with_damage=True))
+            self.material = History(material.isochoric(with_damage=True),
+                                    lambda: self.point_basis)
         return self
 
     def tension_share(self):

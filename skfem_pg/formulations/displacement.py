@@ -115,8 +115,9 @@ class Hyperelastic:
                              "history: use tangent='consistent'".format(
                                  material))
         self.basis, self.tangent_kind = basis, tangent
-        self.material = History(material) if getattr(
-            material, "stateful", False) else material
+        self.material = (History(material, lambda: self.point_basis)
+                         if getattr(material, "stateful", False)
+                         else material)
         self.n_u = basis.N
         d = _dim(basis)
         self._eye = np.eye(d).reshape(d, d, 1, 1)
@@ -152,7 +153,8 @@ class Hyperelastic:
         its points — how the mixed formulations take a stateful material
         whose volumetric part they treat themselves; returns ``self``."""
         if getattr(material, "stateful", False):
-            self.material = History(material.isochoric())
+            self.material = History(material.isochoric(),
+                                    lambda: self.point_basis)
         return self
 
     def commit(self, state):

@@ -26,21 +26,28 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from ..discretization.nonlocal_mean import NonlocalAverage
+
 
 class History:
     """The committed internal variables of ``material`` at a model's
     points; allocated on the first evaluation (the points' shape is that of
-    ``F.shape[2:]``)."""
+    ``F.shape[2:]``).  ``points``: a callable giving the basis whose
+    integration points these are (the model's ``point_basis``), which a
+    nonlocal damage law averages over
+    (:class:`~skfem_pg.materials.damage.NonlocalStrainDamage`)."""
 
     stateful = True
 
-    def __init__(self, material):
+    def __init__(self, material, points=None):
         if not getattr(material, "stateful", False):
             raise TypeError("{!r} has no history".format(material))
         self.material = material
+        self.points = points
         self.committed = None
         self._last = None  # (F, response)
         self._mean = None  # (F, mean stress): bind_mean_stress
+        self._average = None  # a NonlocalAverage, for its basis
 
     def __repr__(self):
         return "History({!r})".format(self.material)
@@ -71,13 +78,40 @@ class History:
         if self._last is not None and self._last[0] is F:
             return self._last[1]
         self._check(F)
+        kw = {}
         if self._mean is not None and self._mean[0] is F:
-            r = self.material.update(F, self.committed,
-                                     mean_stress=self._mean[1])
-        else:
-            r = self.material.update(F, self.committed)
+            kw["mean_stress"] = self._mean[1]
+        radius = getattr(getattr(self.material, "damage", None), "radius",
+                         None)
+        if radius is not None:
+            kw["average"] = a = self.nonlocal_average(radius)
+            n = int(np.prod(F.shape[2:]))
+            if n != a.n_points:
+                raise ValueError(
+                    "{!r}: the model evaluates its material at {} points, "
+                    "its point basis has {} integration points (a "
+                    "formulation with the material at the masters, as "
+                    "U1SIG): the nonlocal mean is built for the PG and FE "
+                    "displacement and mean-dilatation models".format(
+                        self.material.damage, n, a.n_points))
+        r = self.material.update(F, self.committed, **kw)
         self._last = (F, r)
         return r
+
+    def nonlocal_average(self, radius):
+        """The :class:`~skfem_pg.discretization.nonlocal_mean.
+        NonlocalAverage` of ``radius`` over the points (built again when
+        the model's point basis changes: a crack-aware update)."""
+        basis = None if self.points is None else self.points()
+        if basis is None:
+            raise ValueError(
+                "{!r} is nonlocal, and this History was not given its "
+                "points (History(material, points=...))".format(
+                    self.material.damage))
+        a = self._average
+        if a is None or a.basis is not basis or a.radius != radius:
+            self._average = a = NonlocalAverage(basis, radius)
+        return a
 
     # the stateless-material interface the formulations call
     def stress(self, F):

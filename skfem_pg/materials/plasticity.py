@@ -233,14 +233,17 @@ class J2Plasticity(Material):
         return h
 
     # -- the stress update ---------------------------------------------
-    def update(self, F, history, mean_stress=None):
+    def update(self, F, history, mean_stress=None, average=None):
         """The response to ``F`` ``(d, d, ...)`` from the committed
         ``history`` at the same points: a :class:`Response` with the
         stress ``P``, the trial history and (on demand) the algorithmic
         tangent.  ``mean_stress`` (per point, Kirchhoff): the mean stress
         the damage law's triaxiality takes instead of the law's own
-        volumetric one (a mixed formulation's pressure, times J)."""
-        return Response(self, F, history, mean_stress)
+        volumetric one (a mixed formulation's pressure, times J).
+        ``average``: the nonlocal mean over the points
+        (:class:`~skfem_pg.discretization.nonlocal_mean.NonlocalAverage`),
+        which a nonlocal damage law needs."""
+        return Response(self, F, history, mean_stress, average)
 
     # stateless use (the virgin state): what the elastic formulations and
     # the hyperelastic checks call
@@ -383,7 +386,8 @@ class Response:
     commits), ``plastic`` (where the step yields), :meth:`tangent` and
     :meth:`energy`."""
 
-    def __init__(self, material, F, history, mean_stress=None):
+    def __init__(self, material, F, history, mean_stress=None,
+                 average=None):
         self.material = m = material
         self.F = F
         d = F.shape[0]
@@ -449,7 +453,7 @@ class Response:
         if m.damage is not None:
             damage, released, failed, vol = self._damage(
                 history, damage, (alpha, alpha_n), p, tau_full, vol,
-                mean_stress, btr)
+                mean_stress, btr, average)
         self._failed = failed
         self.failed = failed.reshape(self.point_shape)
         for i in range(3):
@@ -492,7 +496,7 @@ class Response:
         return da
 
     def _damage(self, history, damage, alphas, p, tau_full, vol,
-                mean_stress, btr):
+                mean_stress, btr, average=None):
         """``(damage, released, failed, vol)``: the damage law's step at
         the points (thesis 8.1), the energy density released by the
         points failing now, and a failed point's stress (no deviatoric
@@ -509,7 +513,18 @@ class Response:
                                                         mean[p]))
         strain_law = getattr(m.damage, "indicator", None)
         if strain_law is not None:  # a criterion on the elastic strain
-            damage = np.maximum(damage, strain_law(btr))
+            indicator = strain_law(btr)
+            if getattr(m.damage, "radius", None) is not None:
+                if average is None:
+                    raise ValueError(
+                        "{!r} is nonlocal: it is evaluated at a model's "
+                        "points, which the model binds (PG or FE "
+                        "displacement and mean-dilatation models), not "
+                        "by itself".format(m.damage))
+                # the nonlocal mean over the intact points
+                indicator = average(indicator, history["damage"].reshape(n)
+                                    < m.damage.Dc)
+            damage = np.maximum(damage, indicator)
         failed = damage >= m.damage.Dc
         # the energy density a point failing now releases: what it
         # would store intact, less what it keeps (pressure in
