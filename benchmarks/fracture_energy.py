@@ -21,7 +21,7 @@ triangles and on Kalthoff–Winkler's square grid:
 2. PG kept at h = 2 mm with the stable step scaled by 1, 1/2, 1/4, 1/8:
    the order of what is left;
 3. the mode-I plate pulled slower (1 m/s each grip, to 300 µs), PG kept
-   and crack-aware at h = 2 and 1 mm, with the crack-band criterion and
+   and crack-aware (mesh and kNN families) at h = 2 and 1 mm, with the crack-band criterion and
    with the nonlocal one
    (:class:`~skfem_pg.materials.NonlocalStrainDamage`, radius 4 mm,
    its critical strain from G0): is the released energy per crack
@@ -64,7 +64,8 @@ RADIUS = 4.0  # mm: the nonlocal criterion's radius
 def model_of(kind, mesh, h, radius=None):
     """``(basis, model)``: PG Unl (``VCBCPBG V5sn Unl``) kept or
     crack-aware (its default local VC; ``crack-aware, global VC``: the
-    basis' own, ``vc="basis"``) with the crack-band brittle criterion of
+    basis' own, ``vc="basis"``; ``crack-aware, kNN``: the nearest-neighbour
+    families) with the crack-band brittle criterion of
     spacing ``h`` (with ``radius``: the nonlocal criterion of that radius
     instead), or PMB."""
     if kind == "PMB":
@@ -76,7 +77,9 @@ def model_of(kind, mesh, h, radius=None):
     else:
         law = NonlocalStrainDamage.from_fracture_energy(G0, E, NU, radius)
     steel = J2Plasticity.from_young(E, NU, 1e9, damage=law)  # elastic
-    basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
+    basis = pg.FamilyBasis.from_name(
+        mesh, "VCBCPBG V5sn Unl", dim=2,
+        **({"families": "nearest"} if kind.endswith("kNN") else {}))
     if kind.startswith("crack"):
         return basis, CrackAware(basis, steel, vc="basis"
                                  if kind.endswith("global VC") else "local")
@@ -231,7 +234,7 @@ def main(results=None):
                                        "band / h"], rows))
     rows = []
     for radius in (None, RADIUS):
-        for kind in ("kept", "crack-aware"):
+        for kind in ("kept", "crack-aware", "crack-aware, kNN"):
             for h in (2.0, 1.0):
                 basis, tr, s, model, mesh = mode_one(
                     kind, h, speed=1000.0, t_end=3e-4, radius=radius,

@@ -56,6 +56,7 @@ from skfem_pg.io import VTUSeries, step_writer
 from skfem_pg.materials import (J2Plasticity, JohnsonCookDamage,
                                 JohnsonCookHardening)
 from skfem_pg.scenes.meshing import from_geo, geo_path
+from skfem_pg.solvers import DynamicsError
 from harness import demo_parser, new_figure, output_dir, save_figure
 
 STEEL = J2Plasticity.from_young(
@@ -174,9 +175,12 @@ def run(mesh, method, t_end, snapshots, folder, outputs):
                           else model.intact.copy()))
         series.add(t, step_writer(basis, u=x[:basis.N], damage=D))
     t0 = time.perf_counter()
-    tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), t_end,
-                               D=np.concatenate([bottom, top]), u_D=u_D,
-                               callback=watch, output_every=outputs)
+    try:
+        tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), t_end,
+                                   D=np.concatenate([bottom, top]), u_D=u_D,
+                                   callback=watch, output_every=outputs)
+    except DynamicsError as err:  # reported with what was measured
+        tr = err
     seconds = time.perf_counter() - t0
     return dict(method=method, curve=np.array(curve), shots=shots,
                 first=first[0] if first else None, trajectory=tr,
@@ -189,11 +193,15 @@ def report(r):
     """Print what :func:`run` measured for one model."""
     c = r["curve"]
     peak_f, peak_w = np.argmax(c[:, 1]), np.argmax(c[:, 2])
-    last = r["trajectory"].history[-1]
-    first = r["first"]
-    print("\n{}: {} steps in {:.1f} s".format(r["method"],
-                                              r["trajectory"].steps,
-                                              r["seconds"]))
+    tr, first = r["trajectory"], r["first"]
+    if isinstance(tr, DynamicsError):
+        print("\n{}: stopped at t = {:.3g} s after {:.1f} s ({})".format(
+            r["method"], tr.t, r["seconds"], str(tr).split(": ", 1)[-1]))
+        last = (tr.history or [{"relative_error": np.nan}])[-1]
+    else:
+        last = tr.history[-1]
+        print("\n{}: {} steps in {:.1f} s".format(r["method"], tr.steps,
+                                                  r["seconds"]))
     if first:
         where = first[1]
         print("  first failure at t = {:.3g} s at {} node(s): {}".format(

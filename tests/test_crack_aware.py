@@ -373,6 +373,26 @@ def test_nearest_families_stay_on_their_side_of_removed_cells():
     assert own.sizes[own.masters == inner][0] == 9
 
 
+def test_nearest_families_of_cells_hold_their_cell_neighbours():
+    """On triangles the nearest neighbours miss some particles that share
+    a cell; on a subset of the cells those join, so the crack-aware
+    kNN basis takes the local VC (which needs them) from the start."""
+    mesh = shifted_grid(6, 6).to_meshtri()
+    p = pg.Particles.from_mesh(mesh, elements=np.arange(mesh.t.shape[1]))
+    fam = pg.families.nearest(p, 6)
+    k = np.repeat(fam.masters, fam.sizes)
+    have = set(zip(k.tolist(), fam.members.tolist()))
+    t = mesh.t
+    pairs = {(int(a), int(b)) for c in t.T for a in c for b in c}
+    assert pairs <= have
+    euclid = pg.families.nearest(pg.Particles(p.x, p.volumes), 6)
+    k = np.repeat(euclid.masters, euclid.sizes)
+    assert not pairs <= set(zip(k.tolist(), euclid.members.tolist()))
+    model = CrackAware(pg.FamilyBasis(mesh, dim=2, families="nearest"),
+                       STEEL)
+    assert model.current.vc_report.solver == "local"
+
+
 def test_crack_aware_strip_separates_with_nearest_neighbour_families():
     """The notched strip with the kNN families (``families="nearest"``):
     rebuilt among the intact cells' particles, no family spans the crack

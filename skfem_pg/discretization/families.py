@@ -393,9 +393,10 @@ def _nearest_in_cells(particles, act, n, tol, max_rings=6):
     """The ``n`` nearest (with ties within ``tol``) of each active
     particle among those its element subset connects within a few rings
     of cells (grown ring by ring, at most ``max_rings``, until every
-    particle has ``n`` candidates or its piece has no more): no family
-    reaches across a gap of removed cells, as the Euclidean nearest
-    neighbours would."""
+    particle has ``n`` candidates or its piece has no more), and every
+    particle that shares a cell with it (what the local VC correction
+    needs): no family reaches across a gap of removed cells, as the
+    Euclidean nearest neighbours would."""
     mesh, N = particles.mesh, particles.n
     t = mesh.t[:, np.asarray(mesh.normalize_elements(particles.elements))]
     E = sp.csr_matrix((np.ones(t.size, dtype=bool),
@@ -426,8 +427,11 @@ def _nearest_in_cells(particles, act, n, tol, max_rings=6):
     # rank 0), or of the last candidate of a smaller piece
     nth = dist[start + np.minimum(n, count[i] - 1)]
     keep = dist <= nth * (1.0 + tol) if tol > 0 else rank <= n
-    return sp.csr_matrix((np.ones(int(keep.sum()), dtype=bool),
-                          (i[keep], j[keep])), shape=(N, N))
+    A = sp.csr_matrix((np.ones(int(keep.sum()), dtype=bool),
+                       (i[keep], j[keep])), shape=(N, N))
+    rows = sp.csr_matrix((np.ones(act.size, dtype=bool), (act, act)),
+                         shape=(N, N))
+    return (A + rows @ ring).astype(bool).tocsr()
 
 
 def _positive_number(value, what):
