@@ -335,8 +335,9 @@ def nearest(particles, n, pairwise=True, min_size=None, ties=True,
     On particles of a subset of a mesh's cells
     (``Particles.from_mesh(mesh, elements=...)``: what a crack-aware
     update collocates) the neighbours are taken among the particles the
-    cells connect within a few rings, so that no family reaches across
-    removed cells.
+    cells connect within a few rings, and every particle that shares a
+    cell joins (the local VC correction needs them), so that no family
+    reaches across removed cells.
 
     >>> import numpy as np, skfem as fem, skfem_pg as pg
     >>> m = fem.MeshQuad.init_tensor(*(2 * [range(5)]))

@@ -41,11 +41,12 @@ master):
   with the basis' own options on these particles; the mesh rule then
   builds the families from the intact cells, and the nearest-neighbour
   rule (``families="nearest"``, the kNN recipe) takes the nearest among
-  the particles the intact cells connect
+  the particles the intact cells connect and those sharing a cell
   (:func:`~skfem_pg.discretization.families.nearest`), so no family spans
-  a failed cell.  The VC correction is the global solve of the basis (the cost of an
-  update, :attr:`CrackAware.update_seconds`); it runs only in steps in
-  which cells fail;
+  a failed cell.  The VC correction is the local one (``vc="local"``,
+  the default, below) or the basis' own (``vc="basis"``); an update (its
+  cost: :attr:`CrackAware.update_seconds`) runs only in steps in which
+  cells fail;
 * **semi-total Lagrangian gradients**: after an update at :math:`u_c`,
 
   .. math::
