@@ -266,13 +266,19 @@ def from_mesh(mesh_or_particles, elements=None, min_size=None, order=1):
     tind = (np.arange(mesh.nelements) if elements is None
             else np.asarray(mesh.normalize_elements(elements)))
     t = mesh.t[:, tind]
-    nv = mesh.nvertices
-    E = sp.csr_matrix((np.ones(t.size, dtype=bool),
-                       (t.ravel(), np.tile(np.arange(len(tind)), t.shape[0]))),
-                      shape=(nv, len(tind)))
-    A = (E @ E.T).astype(bool)
+    A = _cell_adjacency(t, mesh.nvertices)
     masters = np.unique(t)
     return _complete(x, A, masters, min_size, order=order)
+
+
+def _cell_adjacency(t, nv):
+    """``(nv, nv)`` boolean: the vertices that share a cell of ``t``
+    (``(corners, cells)``), each with itself."""
+    E = sp.csr_matrix((np.ones(t.size, dtype=bool),
+                       (t.ravel(), np.tile(np.arange(t.shape[1]),
+                                           t.shape[0]))),
+                      shape=(nv, t.shape[1]))
+    return (E @ E.T).astype(bool).tocsr()
 
 
 def _active_tree(particles):
@@ -399,12 +405,8 @@ def _nearest_in_cells(particles, act, n, tol, max_rings=6):
     needs): no family reaches across a gap of removed cells, as the
     Euclidean nearest neighbours would."""
     mesh, N = particles.mesh, particles.n
-    t = mesh.t[:, np.asarray(mesh.normalize_elements(particles.elements))]
-    E = sp.csr_matrix((np.ones(t.size, dtype=bool),
-                       (t.ravel(), np.tile(np.arange(t.shape[1]),
-                                           t.shape[0]))),
-                      shape=(N, t.shape[1]))
-    ring = (E @ E.T).astype(bool).tocsr()
+    ring = _cell_adjacency(mesh.t[:, np.asarray(mesh.normalize_elements(
+        particles.elements))], N)
     C = ring
     for _ in range(max_rings - 1):  # the next ring of the short rows
         short = act[C.getnnz(axis=1)[act] < n + 1]
