@@ -2,7 +2,8 @@
 method with adaptive load steps that drives any formulation (and commits
 the history of plastic models per converged step), checkpoints; dynamics:
 lumped mass, implicit Newmark, explicit central differences, a rigid
-frictionless wall, energy bookkeeping.  The drivers take a
+frictionless wall, energy bookkeeping; free-surface flow on particles that
+re-neighbour (:func:`free_surface_flow`).  The drivers take a
 :class:`~skfem_pg.solvers.problem.Problem` (or a model and its loads as
 keywords)."""
 from .linear import (direct, Factorization, linear_solver, AMGSolver, rigid_body_modes,
@@ -16,6 +17,7 @@ from .mass import lumped_mass
 from .dynamics import DynamicsError, Trajectory, EnergyBalance
 from .contact import RigidWall
 from .newmark import newmark
+from .free_surface import free_surface_flow, FlowResult
 from .explicit import (central_difference, stable_time_step,
                        max_frequency)
 from . import checkpoint
@@ -29,4 +31,5 @@ __all__ = ["direct", "Factorization", "linear_solver", "AMGSolver", "rigid_body_
            "ConvergenceError", "PG_CANDIDATES", "as_dofs", "checkpoint",
            "lumped_mass", "DynamicsError", "Trajectory", "EnergyBalance",
            "RigidWall", "newmark", "central_difference", "stable_time_step",
-           "max_frequency", "Problem", "Solution"]
+           "max_frequency", "Problem", "Solution", "free_surface_flow",
+           "FlowResult"]

@@ -29,6 +29,10 @@ class RigidWall:
 
     ``tol``: the penetration (a length) below which a dof counts as on the
     wall; default 1e-9 of the body's extent along ``axis``.
+    ``release=False``: a dof once held stays on the wall (it slides along
+    it, never lifts off) — a wall that a fluid wets, which no tension
+    draws the fluid off (:class:`~skfem_pg.formulations.
+    UpdatedLagrangeFluid`); implicit runs only.
 
     Examples
     --------
@@ -41,7 +45,8 @@ class RigidWall:
 
     """
 
-    def __init__(self, axis, position=0.0, side=1, tol=None):
+    def __init__(self, axis, position=0.0, side=1, tol=None,
+                 release=True):
         if side not in (1, -1):
             raise ValueError("side must be +1 or -1, got {!r}".format(side))
         if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)):
@@ -55,10 +60,12 @@ class RigidWall:
                              .format(tol))
         self.axis, self.position, self.side = int(axis), float(position), side
         self.tol = tol
+        self.release = bool(release)
 
     def __repr__(self):
-        return "RigidWall(axis={}, position={}, side={:+d})".format(
-            self.axis, self.position, self.side)
+        return "RigidWall(axis={}, position={}, side={:+d}{})".format(
+            self.axis, self.position, self.side,
+            "" if self.release else ", release=False")
 
     def bind(self, basis, n_u, D):
         """The candidate dofs (component ``axis`` of every node, except
@@ -104,7 +111,10 @@ class RigidWall:
     def compressive(self, force):
         """Mask of the candidates whose wall force (``force``: the force
         the wall must exert on each candidate dof to hold it) pushes the
-        body away from the wall."""
+        body away from the wall (all of them for a wall that does not
+        release)."""
+        if not self.release:
+            return np.ones(np.shape(force), dtype=bool)
         return self.side * force > 0
 
 

@@ -575,7 +575,8 @@ def _onto_walls(walls, cand, held, u, un, vh, h):
     """Predicted positions behind a wall (or held on it) go onto it, with
     the half-step velocity that gets them there (in place)."""
     for w, c in zip(walls, cand):
-        pen = w.penetrating(un) | held[c]
+        # the held dofs on this wall (two walls may share an axis)
+        pen = w.penetrating(un) | (held[c] & w.on_wall(u))
         un[c[pen]] = w.wall_values()[pen]
         vh[c[pen]] = (un[c[pen]] - u[c[pen]]) / h
 

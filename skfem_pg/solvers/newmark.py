@@ -124,7 +124,8 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
             solver: str | Callable = "auto", wall=None,
             callback: Callable | None = None, checkpoint=None,
             resume: str | None = None,
-            controls: NewmarkControls | None = None, **kw) -> Trajectory:
+            controls: NewmarkControls | None = None,
+            gravity: ArrayLike | None = None, **kw) -> Trajectory:
     r"""Integrate :math:`M\ddot u + f_{int}(u) = f_{ext}(t)` from 0 to
     ``t_end`` by Newmark's method (module docstring).
 
@@ -156,6 +157,12 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
     callback
         ``callback(t, x, v, record)`` at the start and every
         ``output_every`` converged steps, and at the end.
+    gravity
+        An acceleration vector ``(d,)``: the weight :math:`m g` of the
+        lumped mass at each displacement dof, added to ``f_ext``.  A model
+        whose commit rebuilds its discretization and offers ``mass()``
+        (:class:`~skfem_pg.formulations.UpdatedLagrangeFluid`) gets that
+        mass after each rebuild, and the weight follows it.
     controls, **kw
         :class:`~skfem_pg.solvers.NewmarkControls` (``beta``, ``gamma``,
         ``dt_min``, ``tol``, ``maxiter``, ``line_search``,
@@ -187,7 +194,7 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
                                      and 0 < c.dt_min <= dt):
         raise ValueError("dt_min must lie in (0, dt], got {!r}".format(
             c.dt_min))
-    run = bind_problem(problem, m)
+    run = with_weight(bind_problem(problem, m), gravity)
     check_sliding(model.basis, run.D)
     x = (model.initial() if hasattr(model, "initial")
          else np.zeros(N)).copy()
@@ -214,6 +221,58 @@ def newmark(model: Model | Problem, m: ArrayLike | None = None,
     stepper.times["total"] = sum(stepper.times.values())
     return Trajectory(stepper.x, stepper.v, stepper.a, stepper.t,
                       stepper.hist, stepper.steps, dict(stepper.times))
+
+
+def with_weight(run, gravity):
+    """The bound problem ``run`` with the weight of its lumped mass under
+    ``gravity`` (``None``: unchanged) added to its loads."""
+    if gravity is None:
+        return run
+    basis = run.model.basis
+    d = basis.doflocs.shape[0]
+    g = np.asarray(gravity, dtype=float)
+    if g.shape != (d,) or not np.all(np.isfinite(g)):
+        raise ValueError("gravity must be a finite vector of {} components, "
+                         "got {!r}".format(d, gravity))
+    loads = run.f_of
+    loads.weight = (loads, g, dof_components(basis, run.model.n_u))
+    return with_mass(run, run.m)
+
+
+def with_mass(run, m):
+    """``run`` with the lumped mass ``m``; its weight
+    (:func:`with_weight`) follows."""
+    m = np.asarray(m, dtype=float)
+    weight = getattr(run.f_of, "weight", None)
+    if weight is None:
+        return run._replace(m=m)
+    loads, g, comp = weight
+    w = g[comp] * m
+
+    def f_of(t):
+        f = np.array(loads(t), dtype=float)
+        f[:w.size] += w
+        return f
+    f_of.weight = weight
+    return run._replace(m=m, f_of=f_of)
+
+
+def dof_components(basis, n_u):
+    """The component (0 … d-1) of each displacement dof of ``basis``: a
+    family basis' dofs interleave them; a scikit-fem vector basis names
+    them per node (``nodal_dofs``) — other dofs raise naming the basis."""
+    d = basis.doflocs.shape[0]
+    if getattr(basis, "families", None) is not None:
+        return np.arange(n_u) % d
+    comp = np.full(n_u, -1)
+    nodal = np.asarray(basis.nodal_dofs)
+    for i in range(min(d, nodal.shape[0])):
+        comp[nodal[i]] = i
+    if (comp < 0).any():
+        raise ValueError("gravity needs the component of each dof: {} has "
+                         "dofs that are not nodal components (give the "
+                         "weight as f_ext)".format(type(basis).__name__))
+    return comp
 
 
 class _Newmark:
@@ -303,7 +362,14 @@ class _Newmark:
         fe_n = run.f_of(t + h)
         if commit(model, state, t + h, self.x, self.v, self.hist):
             # the families were rebuilt: the force and the acceleration
-            # of the new basis (lumped mass)
+            # of the new basis (lumped mass, the model's new one if it
+            # has one), a viscous stress with the step's final velocity
+            # gradient on it
+            if hasattr(model, "mass"):
+                self.run = run = with_mass(run, model.mass())
+                self.energy.m = run.m
+                fe_n = run.f_of(t + h)
+            bind_velocity_rate(model, vn, h, self.c.beta, self.c.gamma)
             state = model.state(xn)
             fi_before = fi_n
             fi_n = np.asarray(model.internal_force(state), dtype=float)
@@ -360,7 +426,9 @@ def _step(run, controls, start_state, t, h, solver, solvers, times):
         values = np.zeros(N)
         values[Dd] = uD[Dd]
         for w, cw in zip(walls, cand):
-            values[cw] = w.wall_values()
+            # a held dof is on its own wall (two walls may share an axis)
+            own = w.on_wall(start)
+            values[cw[own]] = w.wall_values()[own]
         I = np.setdiff1d(np.arange(N), C)
         key = I.tobytes()
         if key not in solvers:
@@ -385,7 +453,8 @@ def _step(run, controls, start_state, t, h, solver, solvers, times):
             R = fi[:n_u] - f_of(t + h)[:n_u]  # what the wall must push
             for w, cw in zip(walls, cand):
                 hw = held[cw]
-                release = hw & ~w.compressive(R[cw])
+                # only this wall's held dofs (two walls may share an axis)
+                release = hw & w.on_wall(xn) & ~w.compressive(R[cw])
                 enter = ~hw & w.penetrating(xn)
                 if release.any() or enter.any():
                     changed = True
