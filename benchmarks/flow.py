@@ -35,8 +35,7 @@ from harness import demo_parser, markdown_table, update_results
 import skfem_pg as pg
 import skfem_pg.solvers.rates as rates
 from skfem_pg.formulations import model_for
-from skfem_pg.discretization.retriangulation import (alpha_shape,
-                                                      free_particles)
+from skfem_pg.discretization.retriangulation import attached
 from skfem_pg.materials import NewtonianFluid
 from skfem_pg.solvers import DynamicsError, RigidWall, free_surface_flow
 
@@ -148,9 +147,7 @@ def poiseuille(method, mesh):
 def front(x, m):
     """The surge front: the largest x of the particles in the alpha shape
     (spacings from the masses; a drop ahead of it does not count)."""
-    mesh, kept = alpha_shape(x, np.sqrt(m / RHO), 1.2)
-    on = np.setdiff1d(np.arange(x.shape[1]), free_particles(mesh, kept))
-    return x[0, on].max()
+    return x[0, attached(x, np.sqrt(m / RHO))].max()
 
 
 def dam_break(frame, method, n, perturb=0.0, simplex=False):

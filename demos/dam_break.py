@@ -32,7 +32,7 @@ import skfem as fem
 
 import skfem_pg as pg
 from skfem_pg.discretization.retriangulation import (alpha_shape,
-                                                      free_particles)
+                                                      attached)
 from skfem_pg.formulations import model_for
 from skfem_pg.io import VTUSeries
 from skfem_pg.materials import NewtonianFluid
@@ -67,9 +67,7 @@ def column(n, perturb):
 def front(x, m):
     """The furthest particle of the alpha shape (a drop ahead of the
     surge does not count), over a."""
-    mesh, kept = alpha_shape(x, np.sqrt(m / RHO), 1.2)
-    on = np.setdiff1d(np.arange(x.shape[1]), free_particles(mesh, kept))
-    return x[0, on].max() / A
+    return x[0, attached(x, np.sqrt(m / RHO))].max() / A
 
 
 def energy(x, v, m):

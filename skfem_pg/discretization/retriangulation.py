@@ -117,6 +117,16 @@ def free_particles(mesh, kept):
     return np.setdiff1d(np.arange(mesh.p.shape[1]), mesh.t[:, kept])
 
 
+def attached(x, spacing, alpha=1.2):
+    """Mask of the points ``x`` in a cell of their alpha shape
+    (:func:`alpha_shape`): the body, without the free particles (a drop
+    ahead of a surge)."""
+    mesh, kept = alpha_shape(x, spacing, alpha)
+    out = np.ones(np.shape(x)[1], dtype=bool)
+    out[free_particles(mesh, kept)] = False
+    return out
+
+
 def collocate(mesh, kept):
     """The particles of the alpha shape ``(mesh, kept)``
     (:func:`alpha_shape`): collocated from the kept cells, the free

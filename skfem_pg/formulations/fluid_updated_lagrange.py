@@ -34,7 +34,9 @@ With :math:`F_c` constant over a family the reference weights are
 :math:`w_c/J_c`, the mean dilatation of :class:`~skfem_pg.formulations.
 MeanDilatation` is :math:`\Theta = J_c \sum_j w_{c,j}\det\Delta F^j /
 \sum_j w_{c,j}`, the internal force :math:`\sum w_c\, P F_c^T/J_c :
-\nabla_c\delta u`, and both tangent parts scale by :math:`J_c^{2/d-1}`.
+\nabla_c\delta u`, and both tangent parts scale by :math:`J_c^{2/d-1}`,
+which is 1 in 2-D: the tangent is :class:`~skfem_pg.formulations.
+MeanDilatation`'s on the current basis.
 
 **The pressure carried.**  A family's mean dilatation stands for the
 field at its centroid, not at its particle.  The new family of particle
@@ -67,8 +69,8 @@ from ..discretization.retriangulation import (alpha_shape, circumradii,
                                               radius_ratios)
 from ..discretization.assembly import assemble
 from ..threads import kernel
-from .dilatation import MeanDilatation, compressible_moduli, d_JFinvT
-from .displacement import internal_force, material_tangent
+from .dilatation import MeanDilatation, compressible_moduli
+from .displacement import internal_force
 from .history import History
 
 
@@ -304,20 +306,6 @@ class UpdatedLagrangeFluid(MeanDilatation):
         P = self.stress(state) * self._scale(1.0 / self._dim - 1.0)
         return assemble(internal_force, self.current, P=P)
 
-    @kernel
-    def tangent(self, state):
-        E = self.elements
-        f = self._scale(2.0 / self._dim - 1.0)
-        A = (self.material.tangent(state["F"])
-             + state["p"] * d_JFinvT(state["J"], state["Finv"])) * f
-        Th = state["Theta"]
-        Upp = 0.5 * self.K * (1.0 + 1.0 / Th ** 2)
-        S = self._Minv @ E.gram(self.Phi, Upp * f) @ self._Minv
-        C = E.moments(state["J"] * np.swapaxes(state["Finv"], 0, 1),
-                      self.Phi)
-        return assemble(material_tangent, self.current, A=A,
-                        local_extra=E.quadratic_local(C, S))
-
     # -- re-neighbouring -----------------------------------------------
     def commit(self, state):
         """Commit the step; rebuild on the alpha shape of the current
@@ -333,8 +321,6 @@ class UpdatedLagrangeFluid(MeanDilatation):
             return False
         mesh, kept = alpha_shape(x, self.spacing, self.alpha)
         self.rebuild(mesh, kept, u, state["c_Theta"][:, 0])
-        self._cells = np.array(mesh.t[:, kept])
-        self._q0 = radius_ratios(mesh.p, self._cells)
         return True
 
     def _cells_hold(self, x):
@@ -363,6 +349,8 @@ class UpdatedLagrangeFluid(MeanDilatation):
         self._start_from(new)
         self._m = self._consistent_mass(new, self._m)
         self.u_c = np.array(u, dtype=float)
+        self._cells = np.array(mesh.t[:, kept])
+        self._q0 = radius_ratios(mesh.p, self._cells)
         h = self.history
         h.committed = {"alpha": np.zeros(self._Jc_points.shape),
                        "F": self._eye * self._scale(1.0 / d)}

@@ -80,8 +80,7 @@ class RigidWall:
         self.dofs = dofs
         self.X = locs[self.axis, dofs]
         if self.tol is None:
-            ext = np.ptp(locs[self.axis]) if locs.shape[1] else 1.0
-            self.tol = 1e-9 * max(ext, 1e-300)
+            self.tol = self.default_tol(locs)
         behind = self.side * (self.X - self.position) < -self.tol
         if behind.any():
             i = np.flatnonzero(behind)[0]
@@ -90,6 +89,12 @@ class RigidWall:
                 "{} = {}".format(self, behind.sum(), dofs[i], "xyz"[self.axis],
                                  self.X[i]))
         return dofs
+
+    def default_tol(self, x):
+        """1e-9 of the extent along the axis of the points ``x``
+        ``(d, n)``: the ``tol`` of a wall not given one."""
+        ext = np.ptp(x[self.axis]) if x.shape[1] else 1.0
+        return 1e-9 * max(ext, 1e-300)
 
     def gap(self, u):
         """Signed distances of the candidates to the wall (negative:

@@ -88,8 +88,8 @@ def merge_close(x, v, m, theta, spacing, pairs, walls=()):
         vi = (m[i] * v[:, i] + m[j] * v[:, j]) / M
         for w in walls:
             a = w.axis
-            on = [abs(x[a, k] - w.position) <= _wall_tol(w, x) for k in
-                  (i, j)]
+            tol = w.default_tol(x) if w.tol is None else w.tol
+            on = [abs(x[a, k] - w.position) <= tol for k in (i, j)]
             if any(on):
                 xi[a] = w.position
                 vi[a] = max(0.0, w.side * vi[a]) * w.side
@@ -99,11 +99,6 @@ def merge_close(x, v, m, theta, spacing, pairs, walls=()):
         keep[j] = False
     return (x[:, keep], v[:, keep], m[keep], theta[keep], spacing[keep],
             done)
-
-
-def _wall_tol(wall, x):
-    return wall.tol if wall.tol is not None else 1e-9 * max(
-        np.ptp(x[wall.axis]), 1e-300)
 
 
 class _Restart(Exception):

@@ -234,9 +234,8 @@ def with_weight(run, gravity):
     if g.shape != (d,) or not np.all(np.isfinite(g)):
         raise ValueError("gravity must be a finite vector of {} components, "
                          "got {!r}".format(d, gravity))
-    loads = run.f_of
-    loads.weight = (loads, g, dof_components(basis, run.model.n_u))
-    return with_mass(run, run.m)
+    weight = (run.f_of, g, dof_components(basis, run.model.n_u))
+    return _weighted(run, weight, run.m)
 
 
 def with_mass(run, m):
@@ -246,6 +245,12 @@ def with_mass(run, m):
     weight = getattr(run.f_of, "weight", None)
     if weight is None:
         return run._replace(m=m)
+    return _weighted(run, weight, m)
+
+
+def _weighted(run, weight, m):
+    """``run`` with the mass ``m`` and the loads ``weight[0]`` plus the
+    weight of ``m`` under ``weight[1]`` (components ``weight[2]``)."""
     loads, g, comp = weight
     w = g[comp] * m
 
