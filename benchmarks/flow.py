@@ -29,6 +29,8 @@ Water (rho = 1e3 kg/m^3, K = 2.08 GPa, eta = 1e-3 Pa s,
 Run: ``python benchmarks/flow.py --results benchmarks/README.md`` (about
 15 min on 2 cores).
 """
+import os
+import sys
 import time
 
 import numpy as np
@@ -39,25 +41,18 @@ from harness import demo_parser, markdown_table, update_results
 import skfem_pg as pg
 import skfem_pg.solvers.rates as rates
 from skfem_pg.formulations import model_for
-from skfem_pg.discretization.retriangulation import attached
 from skfem_pg.materials import NewtonianFluid
 from skfem_pg.solvers import (DynamicsError, NewmarkControls, RigidWall,
                               free_surface_flow)
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                os.pardir, "demos"))
+# the experiments' fronts, the front (over a) and its table cells
+from dam_break import (MARTIN_MOYCE, OTHER_EXPERIMENTS,
+                       against_experiment, front)
+
 RHO, K, ETA = 1e3, 2.08e9, 1e-3
 PG = "VCBCPBG V5m UnlP0"
-#: (T, Z) of Martin & Moyce's Fig. 3, n^2 = 2, a = 2.25 in
-MARTIN_MOYCE = np.array([
-    [0.832, 1.217], [1.219, 1.474], [1.997, 2.292], [2.547, 2.995],
-    [3.345, 4.134], [4.034, 4.944], [4.418, 5.881], [5.091, 6.980]])
-#: the same for a = 1.125 in, and Koshizuka & Oka's (1996) experiment
-MARTIN_MOYCE_SMALL = np.array([
-    [0.849, 1.245], [1.212, 1.443], [1.602, 1.884], [2.283, 2.689],
-    [2.950, 3.728], [3.598, 4.528], [3.905, 4.999], [4.592, 5.841]])
-KOSHIZUKA_OKA = np.array([
-    [0.0, 1.0], [0.381, 1.111], [0.769, 1.252], [1.153, 1.505],
-    [1.537, 1.892], [1.935, 2.241], [2.323, 2.615], [2.719, 3.003],
-    [3.096, 3.624]])
 
 
 def grid(n, lengths, perturb=0.0, simplex=False):
@@ -157,12 +152,6 @@ def poiseuille(method, mesh):
     return (np.abs(v[middle] - exact).max() / v_max, tr.steps, s)
 
 
-def front(x, m):
-    """The surge front: the largest x of the particles in the alpha shape
-    (spacings from the masses; a drop ahead of it does not count)."""
-    return x[0, attached(x, np.sqrt(m / RHO))].max()
-
-
 def dam_break(frame, method, n, perturb=0.0, simplex=False, controls=None):
     """The dam break on ``n x 2n`` particles (``perturb``: interior nodes
     moved, ``simplex``: triangles) in the total Lagrangian frame
@@ -178,7 +167,7 @@ def dam_break(frame, method, n, perturb=0.0, simplex=False, controls=None):
     out = []
 
     def record(t, x, v, m):
-        out.append((t * scale, front(x, m) / a, 0.5 * np.sum(
+        out.append((t * scale, front(x, m), 0.5 * np.sum(
             m * (v * v).sum(axis=0)) + g * np.sum(m * x[1]),
             x[0].max() / a))
     t0 = time.perf_counter()
@@ -291,17 +280,8 @@ def main(results=None):
              None)):
         T, Z, Zmax, gain, end, merges, s = dam_break(
             frame, method, n, perturb, simplex, controls)
-        cells = []
-        for Tq in (1.0, 2.0, 3.0, 4.0):
-            if Tq > T[-1] + 1e-9:
-                cells.append("—")
-                continue
-            z = np.interp(Tq, T, Z)
-            zm = np.interp(Tq, *MARTIN_MOYCE.T)
-            cells.append("{:.2f} ({:+.0f} %)".format(z, 100 * (z / zm - 1)))
-        z = np.interp(2.0, T, Zmax) if T[-1] >= 2.0 else np.nan
-        cells.append("—" if np.isnan(z) else "{:.2f} ({:+.0f} %)".format(
-            z, 100 * (z / np.interp(2.0, *MARTIN_MOYCE.T) - 1)))
+        cells = against_experiment(T, Z) + against_experiment(T, Zmax,
+                                                              (2.0,))
         name = method + (", re-neighboured" if frame == "UL" else ", TL")
         if controls is not None:
             name += ", trapezoidal rule"
@@ -324,8 +304,8 @@ def main(results=None):
         "stopped at a 5 % gain:\n\n".format(*[", ".join(
             "{:.2f}".format(np.interp(T, *data.T))
             for T in (1.0, 2.0, 3.0, 4.0)[:k])
-            for data, k in ((MARTIN_MOYCE, 4), (MARTIN_MOYCE_SMALL, 4),
-                            (KOSHIZUKA_OKA, 3))])
+            for data, k in zip((MARTIN_MOYCE, *OTHER_EXPERIMENTS.values()),
+                               (4, 4, 3))])
         + markdown_table(["run", "particles", "T = 1", "T = 2", "T = 3",
                           "T = 4", "T = 2, furthest particle", "ended",
                           "energy gain", "energy at the end", "merged",

@@ -83,6 +83,20 @@ def front(x, m):
     return x[0, attached(x, np.sqrt(m / RHO))].max() / A
 
 
+def against_experiment(T, Z, times=(1.0, 2.0, 3.0, 4.0)):
+    """Table cells of a front ``Z(T)`` at ``times``: its value and its
+    signed error against Martin & Moyce (``—`` past the run's end)."""
+    cells = []
+    for Tq in times:
+        if Tq > T[-1] + 1e-9:
+            cells.append("—")
+            continue
+        z = np.interp(Tq, T, Z)
+        cells.append("{:.2f} ({:+.0f} %)".format(
+            z, 100 * (z / np.interp(Tq, *MARTIN_MOYCE.T) - 1)))
+    return cells
+
+
 def energy(x, v, m):
     return 0.5 * np.sum(m * (v * v).sum(axis=0)) + G * np.sum(m * x[1])
 
@@ -170,14 +184,7 @@ def main():
                                 None, "", 0.0)),
             ("re-neighboured", ul[:3] + ul[4:5] + ul[6:]),
             ("total Lagrangian", tl)):
-        cells = []
-        for Tq in (1.0, 2.0, 3.0, 4.0):
-            if Tq > T[-1] + 1e-9:
-                cells.append("—")
-                continue
-            z = np.interp(Tq, T, Z)
-            zm = np.interp(Tq, *MARTIN_MOYCE.T)
-            cells.append("{:.2f} ({:+.0f}%)".format(z, 100 * (z / zm - 1)))
+        cells = against_experiment(T, Z)
         gain = "" if E is None else "{:+.1f}%".format(
             100 * (E.max() - E[0]) / (2 * E[0]))
         print("{:22s} {:>13s} {:>13s} {:>13s} {:>13s} {:>8s} {:6.1f}  {}"

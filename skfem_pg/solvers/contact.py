@@ -96,6 +96,13 @@ class RigidWall:
         ext = np.ptp(x[self.axis]) if x.shape[1] else 1.0
         return 1e-9 * max(ext, 1e-300)
 
+    def touching(self, x):
+        """Mask of the points ``x`` ``(d, n)`` (positions, not bound
+        dofs) on or behind the wall, within ``tol`` (:meth:`default_tol`
+        of ``x`` for a wall not given one)."""
+        tol = self.default_tol(x) if self.tol is None else self.tol
+        return self.side * (x[self.axis] - self.position) <= tol
+
     def gap(self, u):
         """Signed distances of the candidates to the wall (negative:
         behind it)."""

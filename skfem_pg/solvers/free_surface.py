@@ -98,19 +98,17 @@ def merge_close(x, v, m, theta, spacing, pairs, walls=()):
         taken[i] = taken[j] = True
         done.append((int(i), int(j)))
     keep = np.ones(x.shape[1], dtype=bool)
+    touching = [w.touching(x) for w in walls]
     x, v, m = x.copy(), v.copy(), m.copy()
     theta, spacing = theta.copy(), spacing.copy()
     for i, j in done:
         M = m[i] + m[j]
         xi = (m[i] * x[:, i] + m[j] * x[:, j]) / M
         vi = (m[i] * v[:, i] + m[j] * v[:, j]) / M
-        for w in walls:
-            a = w.axis
-            tol = w.default_tol(x) if w.tol is None else w.tol
-            on = [abs(x[a, k] - w.position) <= tol for k in (i, j)]
-            if any(on):
-                xi[a] = w.position
-                vi[a] = max(0.0, w.side * vi[a]) * w.side
+        for w, on in zip(walls, touching):
+            if on[i] or on[j]:
+                xi[w.axis] = w.position
+                vi[w.axis] = max(0.0, w.side * vi[w.axis]) * w.side
         theta[i] = (m[i] * theta[i] + m[j] * theta[j]) / M
         spacing[i] = (spacing[i] ** d + spacing[j] ** d) ** (1.0 / d)
         x[:, i], v[:, i], m[i] = xi, vi, M
@@ -123,8 +121,7 @@ def _on_walls(x, walls):
     """``(d, n)``: whether a particle's coordinate is held by a wall."""
     on = np.zeros(x.shape, dtype=bool)
     for w in walls:
-        tol = w.default_tol(x) if w.tol is None else w.tol
-        on[w.axis] |= np.abs(x[w.axis] - w.position) <= tol
+        on[w.axis] |= w.touching(x)
     return on
 
 
