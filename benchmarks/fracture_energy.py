@@ -5,7 +5,10 @@ With an elastic material and a brittle criterion, the internal work of a
 run is the energy stored plus the energy the failed points, broken bonds
 and crack updates released: the ratio (W_int − stored − released) / W_int
 measures the booking of the released energy (the drivers' own balance,
-kinetic energy and work, does not see it).  Runs, on unstructured gmsh
+kinetic energy and work, does not see it).  The closure energy (what
+the steps lose where failed points close and open across the kink of
+their pressure in compression, :meth:`~skfem_pg.materials.plasticity.
+Response.closure_step`) is booked apart and reported beside it.  Runs, on unstructured gmsh
 triangles and on Kalthoff–Winkler's square grid:
 
 1. the mode-I plate (``meshes/plate_slot.geo``: 40 x 40 mm, a 12 mm slot,
@@ -96,17 +99,20 @@ def row(name, basis, tr, seconds):
     if isinstance(tr, DynamicsError):  # a run that stopped: why and when
         why = str(tr).split(": ", 1)[-1].split(" at t")[0]
         return [name, str(basis.particles.n), "stopped at t = {:.3g} s "
-                "({})".format(tr.t, why), "", "", "",
+                "({})".format(tr.t, why), "", "", "", "",
                 "{:.1f}".format(seconds)]
     last = tr.history[-1]
     w = last["internal_work"]
+    closure = last.get("closure")
     return [name, str(basis.particles.n), str(tr.steps),
             "{:+.1e}".format(last["other_dissipation"] / w),
+            "" if closure is None else "{:.1e}".format(closure / w),
             "{:+.1e}".format(last["relative_error"]),
             "{:.2f}".format(last["fracture"] / w), "{:.1f}".format(seconds)]
 
 
-HEADER = ["run", "particles", "steps", "(W_int − stored − released)/W_int",
+HEADER = ["run", "particles", "steps",
+          "(W_int − stored − released − closure)/W_int", "closure/W_int",
           "drivers' balance", "released/W_int", "s"]
 
 

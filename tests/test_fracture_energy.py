@@ -1,9 +1,10 @@
 """The energy a fracture releases, booked as the integrator books the work
 of the step in which a point fails or a bond breaks (issue 51): a bond
 breaking in one step (exact), a point failing in one step (to third order
-in the step), and the mode-I plate on unstructured triangles, where every
-joule the internal forces did is stored or released (the material is
-elastic, its criterion brittle)."""
+in the step), a failed point closing across the kink of its pressure,
+and the mode-I plate on unstructured triangles, where every joule the
+internal forces did is stored, released or lost at the failed points'
+closure (the material is elastic, its criterion brittle)."""
 import numpy as np
 import pytest
 import skfem as fem
@@ -11,7 +12,9 @@ import skfem as fem
 import skfem_pg as pg
 from skfem_pg.formulations import CrackAware, model_for
 from skfem_pg.formulations.bond_based import BondBased
-from skfem_pg.materials import CriticalStrainDamage, J2Plasticity
+from skfem_pg.solvers import DynamicsError
+from skfem_pg.materials import (CriticalStrainDamage, J2Plasticity,
+                                NonlocalStrainDamage)
 
 #: N, mm, s: Kalthoff–Winkler's maraging steel (demos/kalthoff_winkler.py)
 E, NU, G0, RHO = 190e3, 0.3, 22.17, 8e-9
@@ -75,6 +78,34 @@ def test_a_point_failing_in_a_step_releases_the_work_booked_on_it():
     assert np.all(misses < 1e-3 * np.array(half_steps))
 
 
+def test_a_failed_point_closing_loses_what_the_trapezoid_books_more():
+    """A failed point carries pressure in compression only: its stress
+    has a kink at J = 1.  A step from J = 1 + a to 1 - b books K b (a + b)
+    / 2 of work (the trapezoid) and stores K b^2 / 2: the closure energy
+    is K a b / 2 to first order (measured here 1.7e-3 and 2.7e-4 off);
+    a step in tension loses nothing, one in compression to third order
+    in the step."""
+    steel = J2Plasticity.from_young(E, NU, 1e9,
+                                    damage=CriticalStrainDamage(0.01))
+    K = steel.K
+
+    def F(J):
+        return np.array([[J, 0.0], [0.0, 1.0]])[:, :, None]
+    failed = steel.update(F(1.05), steel.initial_history((1,)))
+    assert failed.failed.all()
+
+    def closure(J0, J1):
+        r0 = steel.update(F(J0), failed.history)
+        r1 = steel.update(F(J1), r0.history)
+        return r1.history["closure"][0] - r0.history["closure"][0]
+    for a, b in ((1e-3, 2e-3), (2e-3, 5e-4)):
+        assert closure(1 + a, 1 - b) == pytest.approx(0.5 * K * a * b,
+                                                      rel=3e-3)
+    assert closure(1.002, 1.001) == 0.0
+    small = [closure(0.99, 0.99 - d) for d in (2e-3, 1e-3)]
+    assert 7.0 < small[0] / small[1] < 9.0  # third order
+
+
 def slotted_plate(h):
     """The mode-I plate of ``meshes/plate_slot.geo`` on gmsh triangles of
     size ``h`` mm."""
@@ -82,11 +113,11 @@ def slotted_plate(h):
                                size=h)
 
 
-def pull_apart(model, basis, t_end, grip=0.0):
+def pull_apart(model, basis, t_end, grip=0.0, speed=5000.0):
     """Central differences with the stable step: the plate's grips (its
     top and bottom edges, or layers ``grip`` deep: a nonlocal model is
-    held by a layer, not a row) pulled apart at 5 m/s each, sideways
-    free."""
+    held by a layer, not a row) pulled apart at ``speed`` mm/s each
+    (5 m/s), sideways free."""
     X = basis.doflocs
     y = np.arange(basis.N) % 2 == 1
     top = np.flatnonzero(y & (X[1] > 40 - grip - 1e-9))
@@ -94,7 +125,7 @@ def pull_apart(model, basis, t_end, grip=0.0):
 
     def u_D(t):
         u = np.zeros(basis.N)
-        u[top], u[bottom] = 5000.0 * t, -5000.0 * t
+        u[top], u[bottom] = speed * t, -speed * t
         return u
     return pg.central_difference(
         model, pg.lumped_mass(basis, RHO), t_end,
@@ -109,10 +140,11 @@ def test_the_mode_one_plate_on_triangles_books_every_joule(kind):
     criterion) with its connectivity kept and with crack-aware families,
     and the bond-based comparator (held by layers one horizon deep).  The
     cracks run; the internal work is the stored plus the released
-    energy: measured (W_int − stored − released) / W_int +9.5e-4 /
-    +1.0e-3 / +1.1e-4, the released energy 85, 74 and 94 % of W_int, the
-    drivers' own balance 1.9e-3 / 4.2e-3 / 6.7e-3 (until this issue the
-    first ratio was −0.14 for kept and +0.10 for PMB held by its edge
+    energy plus the closure (PG): measured (W_int − stored − released −
+    closure) / W_int +2.8e-5 / +5.2e-5 / +1.1e-4, the closure 9.3e-4 and
+    1.1e-3 of W_int (PG), the released energy 85, 75 and 94 % of W_int,
+    the drivers' own balance 1.9e-3 / 4.0e-3 / 6.7e-3 (until this issue
+    the first ratio was −0.14 for kept and +0.10 for PMB held by its edge
     rows, at h = 2 mm)."""
     h = 4.0
     mesh = slotted_plate(h)
@@ -129,8 +161,56 @@ def test_the_mode_one_plate_on_triangles_books_every_joule(kind):
     tr = pull_apart(model, basis, 6e-5, grip=getattr(model, "horizon", 0))
     last = tr.history[-1]
     assert last["fracture"] > 0.5 * last["internal_work"]  # it broke
-    assert abs(last["other_dissipation"]) <= 1e-2 * last["internal_work"]
+    assert abs(last["other_dissipation"]) <= 1e-3 * last["internal_work"]
     assert abs(last["relative_error"]) <= 2e-2
+
+
+def test_the_plate_with_the_nonlocal_criterion_books_the_closure():
+    """The mode-I plate (h = 4 mm) pulled at 1 m/s for 300 µs, PG Unl with
+    its connectivity kept and the nonlocal criterion (radius 4 mm): the
+    failed band, several spacings wide, closes and opens, and the steps
+    lose energy at the failed points' kink (``closure``).  Measured: the
+    closure 5.2e-3 of W_int, and (W_int − stored − released − closure) /
+    W_int 2.2e-5 (at h = 2 mm 1.2e-2 and 5.6e-5; the closure 3.8e-3 and
+    9.2e-4 with the step halved and quartered, second order).  The
+    drivers' balance takes the closure off the internal work: 3.2e-3,
+    7.7e-3 with it (at h = 2 mm 6.7e-4 and 1.1e-2)."""
+    h = 4.0
+    mesh = slotted_plate(h)
+    law = NonlocalStrainDamage.from_fracture_energy(G0, E, NU, 4.0)
+    steel = J2Plasticity.from_young(E, NU, 1e9, damage=law)
+    basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
+    model = model_for("Unl", basis, steel)
+    tr = pull_apart(model, basis, 3e-4, speed=1000.0)
+    last = tr.history[-1]
+    w = last["internal_work"]
+    assert last["fracture"] > 0.5 * w
+    assert last["closure"] == pytest.approx(model.closure_energy())
+    assert last["closure"] > 2e-3 * w
+    assert abs(last["other_dissipation"]) <= 2e-4 * w
+    scale = last["error"] / last["relative_error"]
+    assert abs(last["relative_error"]) < 5e-3 < (
+        last["error"] + last["closure"]) / scale
+
+
+def test_a_fracture_run_whose_model_makes_energy_stops():
+    """A model whose force is not the gradient of the energy it reports
+    (here the energy reported 1.5 times too large) makes its other
+    dissipation fall as it loads: the run stops with a DynamicsError
+    naming it, instead of booking the difference as negative plastic
+    dissipation (CrackAwareU1SIG's former stabilization on the two-hole
+    plate: a fall of 17 % of the energy scale)."""
+    mesh = slotted_plate(4.0)
+    law = CriticalStrainDamage.from_fracture_energy(G0, E / (1 - NU ** 2),
+                                                    4.0)
+    steel = J2Plasticity.from_young(E, NU, 1e9, damage=law)
+    basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
+    model = model_for("Unl", basis, steel)
+    energy = model.energy
+    model.energy = lambda state: 1.5 * energy(state)
+    with pytest.raises(DynamicsError, match="makes energy") as err:
+        pull_apart(model, basis, 6e-5)
+    assert err.value.t < 6e-5 and err.value.history
 
 
 def test_a_rebuild_is_followed_by_a_new_step_estimate(monkeypatch):

@@ -233,6 +233,9 @@ class _Crack:
         self.u_c = np.zeros(self.N)
         self.F_c = None  # the identity until the first update
         self.released_at_updates = 0.0
+        #: the closure energy (:meth:`closure_energy`) of the points the
+        #: updates removed
+        self.closure_at_updates = 0.0
         self.updates, self.update_seconds, self.update_log = 0, 0.0, []
         self._n_failed = 0
         if vc not in ("local", "basis"):
@@ -312,12 +315,14 @@ class _Crack:
                               "failed: nothing is left to build families on")
         u = np.array(u[:self.N], dtype=float)
         before = self._stored_and_released(u)
+        closure = self._closure()
         new = self._basis_on(intact)
         self._check_pieces(new, intact)
         self.F_c = self._carry(new, np.asarray(F))
         self._set_basis(new)
         self.intact, self.u_c = intact, u
         self.released_at_updates += before - self._stored_and_released(u)
+        self.closure_at_updates += closure - self._closure()
         self.updates += 1
         seconds = time.perf_counter() - t0
         self.update_seconds += seconds
@@ -355,11 +360,13 @@ class _Crack:
 
     def crack_state(self):
         """The crack as checkpoint arrays (``crack_*``): the intact cells,
-        :math:`u_c`, :math:`F_c`, the energy released at updates and the
-        count of failed points."""
+        :math:`u_c`, :math:`F_c`, the energy released at updates, the
+        closure energy of the points they removed and the count of
+        failed points."""
         out = {"crack_intact": self.intact.astype(float),
                "crack_u_c": self.u_c.copy(),
                "crack_released": np.array(self.released_at_updates),
+               "crack_closure": np.array(self.closure_at_updates),
                "crack_n_failed": np.array(float(self._n_failed))}
         if self.F_c is not None:
             out["crack_F_c"] = np.array(self.F_c)
@@ -376,6 +383,7 @@ class _Crack:
         F = crack.get("crack_F_c")
         self.F_c = None if F is None else np.asarray(F, dtype=float)
         self.released_at_updates = float(crack["crack_released"])
+        self.closure_at_updates = float(crack.get("crack_closure", 0.0))
         self._n_failed = int(crack["crack_n_failed"])
 
     # -- the model ------------------------------------------------------
@@ -403,6 +411,16 @@ class _Crack:
         """What the failed points released, plus what the updates released
         (module docstring)."""
         return super().fracture_energy() + self.released_at_updates
+
+    def _closure(self):
+        r = super().closure_energy()
+        return 0.0 if r is None else r
+
+    def closure_energy(self):
+        """The closure energy (:meth:`Hyperelastic.closure_energy
+        <skfem_pg.formulations.Hyperelastic.closure_energy>`), the
+        removed points' included."""
+        return self._closure() + self.closure_at_updates
 
     def book_removed_work(self, work):
         """The driver's correction of an update's released energy: the
@@ -526,7 +544,9 @@ class CrackAwareUnlP0(_Crack, _SemiTotal, MeanDilatation):
     volumetric energy of its intact share only while its failed points
     are in it; rebuilt without them, its whole volumetric energy returns
     (measured on the notched strip of ``tests/test_crack_aware.py``: -87
-    N mm over four updates, against 10,370 N mm dissipated).  Serial only.
+    N mm over four updates, against 10,370 N mm dissipated).  On MPI
+    ranks as :class:`CrackAware` (each rank's families are its masters',
+    so their projections are too).
 
     Examples
     --------
@@ -544,10 +564,6 @@ class CrackAwareUnlP0(_Crack, _SemiTotal, MeanDilatation):
     def __init__(self, basis, material, fraction=0.5, min_piece=None,
                  vc="local"):
         _check_pbg(basis)
-        if getattr(basis, "distributed", None) is not None:
-            raise NotImplementedError(
-                "crack-aware UnlP0 on MPI ranks is not built (crack-aware "
-                "Unl and U1SIG are: CrackAware, CrackAwareU1SIG)")
         _check_crack_inputs(basis, material, fraction, "UnlP0")
         mu, K = compressible_moduli(material, "crack-aware UnlP0")
         MeanDilatation.__init__(self, basis, mu, K)
@@ -568,11 +584,21 @@ class CrackAwareU1SIG(_Crack, U1SIG):
     material and its history at the masters, a cell fails when
     ``fraction`` of its vertices' masters have failed.  After an update
     the master gradients are :math:`F^{kk} = F^{kk}_c + \sum_i (u^i -
-    u^i_c) \otimes G^{kki}` and the implicit-gradient stabilization acts
-    on :math:`u - u_c` [choice made here: the stabilization's accumulated
-    force is dropped at an update, its energy booked as released, as the
-    stabilization only controls the zero-energy modes of the new
-    families].  ``fraction``, ``min_piece`` and ``vc`` as for
+    u^i_c) \otimes G^{kki}`, and the implicit-gradient stabilization acts
+    on the total displacement :math:`u` with the rebuilt families'
+    second derivatives; the change of its energy at an update is booked
+    as released, with the removed points' (module docstring).  The
+    stabilization's energy :math:`\frac12 M_{xx}\,\partial_E H :
+    \tilde A : \partial_E H` is then unchanged by a rigid rotation of a
+    bent piece (:math:`\partial_E H` and :math:`\tilde A` rotate with
+    it).  On :math:`u - u_c` (issue 51 found) it was not: the
+    derivatives of :math:`(R - I) x_c` penalize the rotation of a piece
+    that was bent at the update, and on the two-hole plate (1002
+    particles) the pieces flying apart gained energy from the
+    stabilization's force; the released energy climbed from 520 to
+    1,620 N mm after the plate had come apart (226 N mm in all with the
+    stabilization on :math:`u`, ``benchmarks/README.md``).
+    ``fraction``, ``min_piece`` and ``vc`` as for
     :class:`CrackAware`."""
 
     _gradient_key = "F1"
@@ -624,12 +650,3 @@ class CrackAwareU1SIG(_Crack, U1SIG):
         F = super().master_F(np.asarray(u, dtype=float) - self.u_c)
         return F if self.F_c is None else F - self._eye[:, :, :, 0] \
             + self.F_c
-
-    def stabilization_force(self, u):
-        return super().stabilization_force(np.asarray(u, dtype=float)
-                                           - self.u_c)
-
-    def energy(self, state):
-        du = state["u"] - self.u_c
-        return (self._master_energy(self.material.energy(state["F1"]))
-                + 0.5 * float(du @ self.stabilization_force(state["u"])))

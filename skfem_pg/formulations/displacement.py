@@ -181,9 +181,26 @@ class Hyperelastic:
         a damage law.  Part of the internal work an explicit run records
         as dissipation."""
         r = None if self.history is None else self.history.released()
-        if r is None:
-            return None
-        return float(Elements(self.point_basis).sum(r).sum())
+        return None if r is None else self._point_integral(r)
+
+    def closure_energy(self):
+        """What the trapezoid of the internal work booked beyond the
+        failed points' energy where they close and open (the kink of
+        their pressure at :math:`J = 1`, :meth:`~skfem_pg.materials.
+        plasticity.Response.closure_step`), integrated; ``None`` without a
+        damage law.  The drivers' records carry it apart from the
+        released energy, and their balance takes it off."""
+        r = None if self.history is None else self.history.closure()
+        return None if r is None else self._point_integral(r)
+
+    def _point_integral(self, r):
+        """:math:`\sum w\, r` of point data ``r`` over
+        :attr:`point_basis` (its :class:`Elements` cached: the explicit
+        driver asks for the closure every step)."""
+        E = getattr(self, "_point_elements", None)
+        if E is None or E.basis is not self.point_basis:
+            E = self._point_elements = Elements(self.point_basis)
+        return float(E.sum(r).sum())
 
     def plastic_strain(self):
         """The committed accumulated plastic strain :math:`\\bar e_p`

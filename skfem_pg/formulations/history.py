@@ -186,3 +186,11 @@ class History:
         if self.committed is None:
             return None
         return self.committed.get("released")
+
+    def closure(self):
+        """The committed energy density the steps lost at each failed
+        point (:meth:`~skfem_pg.materials.plasticity.Response.
+        closure_step`; ``None`` as for :meth:`damage`)."""
+        if self.committed is None:
+            return None
+        return self.committed.get("closure")

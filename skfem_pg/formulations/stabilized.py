@@ -273,6 +273,14 @@ class _MasterModel(Hyperelastic):
         r = None if self.history is None else self.history.released()
         return None if r is None else self._master_energy(r)
 
+    def closure_energy(self):
+        """The closure energy of the failed masters, ``None`` without a
+        damage law (as
+        :meth:`Hyperelastic.closure_energy
+        <skfem_pg.formulations.Hyperelastic.closure_energy>`)."""
+        r = None if self.history is None else self.history.closure()
+        return None if r is None else self._master_energy(r)
+
     def _master_force(self, P1):
         r""":math:`\sum_k V^k P^k : \delta F^{kk}` (the U1 weights sum to
         :math:`V^k` and every member carries the master's derivatives),
