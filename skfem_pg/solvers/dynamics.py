@@ -501,6 +501,9 @@ class Recorder:
         self.total = (lambda x: x) if total is None else total
         self.max_dissipation_drop = float(max_dissipation_drop)
         self.hist = []
+        # the largest other dissipation of hist[:_seen] (a resumed run's
+        # records included), kept so that an output reads only its own
+        self._seen, self._most = 0, -np.inf
 
     def __call__(self, t, x, v, state, held, final=False, **data):
         """Record the state at ``t``; ``data``: ``dt``, ``steps`` and what
@@ -529,11 +532,15 @@ class Recorder:
 
     def check_dissipation(self, t, x, v):
         """Stop a run whose other dissipation fell (class docstring)."""
-        others = [r["other_dissipation"] for r in self.hist
-                  if "other_dissipation" in r]
-        if not others:
+        if self._seen > len(self.hist):  # records replaced: read again
+            self._seen, self._most = 0, -np.inf
+        for r in self.hist[self._seen:]:
+            self._most = max(self._most, r.get("other_dissipation", -np.inf))
+        self._seen = len(self.hist)
+        other = self.hist[-1].get("other_dissipation") if self.hist else None
+        if other is None:
             return
-        drop = max(others) - others[-1]
+        drop = self._most - other
         if drop > self.max_dissipation_drop * self.energy.scale:
             raise DynamicsError(
                 "the dissipation other than the released energy (W_int - "
