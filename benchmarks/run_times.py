@@ -147,6 +147,12 @@ SCRIPTS = [
      "pull with the crack band and the nonlocal criterion, and "
      "Kalthoff–Winkler; `--fine`: the nonlocal criterion to h = 0.5 mm, "
      "the step halved (22 min on one core, 2026-12-07)", "12 min", 720),
+    ("crack_paths", ["benchmarks/crack_paths.py"],
+     "Kalthoff–Winkler's crack direction on square grids and gmsh "
+     "triangles at 2 and 1 mm: PMB, PG kept and crack-aware with the "
+     "strain and the stress criterion, against the experiment's 70 "
+     "degrees (grids and triangles in two processes, 2026-12-07)",
+     "2 h", 7200),
     ("factor_reuse", ["benchmarks/factor_reuse.py"],
      "modified Newton (reuse=True) against full Newton: whole solves of "
      "the 3-D Cook, a bracket, necking, the punch", "5 min", 600),

@@ -292,6 +292,52 @@ def test_the_critical_strain_criterion_fails_at_its_strain():
         CriticalStrainDamage(0.0)
 
 
+def test_the_critical_stress_criterion_fails_at_its_stress():
+    """CriticalStressDamage on an elastic J2 point: a uniaxial stretch
+    whose largest Cauchy stress is just below the strength leaves the
+    point intact (damage 1 to round-off), just above fails it; a
+    compression across a free direction, whose Poisson strain fails the
+    strain criterion of the same uniaxial strength, leaves it intact; a
+    mixed formulation's mean stress is the one it takes; the crack-band
+    strength sqrt(2 G0 E / h)."""
+    from skfem_pg.materials import CriticalStrainDamage, CriticalStressDamage
+    f_t = 1000.0
+    law = CriticalStressDamage(f_t)
+    m = J2Plasticity.from_young(E, NU, 1e9, damage=law)
+    plain = J2Plasticity.from_young(E, NU, 1e9)
+    F = lambda a, b=1.0: np.diag([a, b, 1.0])[:, :, None]  # noqa: E731
+
+    def cauchy_xx(a):  # (P F^T / J)_xx = P_xx for F = diag(a, 1, 1)
+        return plain.stress(F(a))[0, 0, 0]
+    lo, hi = 1.0, 1.02  # the stretch at the strength, by bisection
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if cauchy_xx(mid) < f_t else (lo, mid)
+    below = walk(m, [F(1 + 0.5 * (lo - 1)), F(lo * (1 - 1e-9))])
+    assert not below[-1].failed.any()
+    assert below[-1].history["damage"][0] == pytest.approx(1.0, abs=1e-6)
+    after = walk(m, [F(hi * (1 + 1e-9)), F(1.0)])
+    assert after[0].failed.all() and after[1].failed.all()
+    # compressed along y, free along x: a tensile strain, no tensile stress
+    a = 1.0
+    for _ in range(60):  # the stretch along x at which sigma_xx = 0
+        a -= plain.stress(F(a, 0.98))[0, 0, 0] / (E / (1 - NU ** 2))
+    assert abs(plain.stress(F(a, 0.98))[0, 0, 0]) < 1e-6
+    strain_law = CriticalStrainDamage(f_t / (E / (1 - NU ** 2)))
+    by_strain = J2Plasticity.from_young(E, NU, 1e9, damage=strain_law)
+    assert walk(by_strain, [F(a, 0.98)])[0].failed.all()
+    assert not walk(m, [F(a, 0.98)])[0].failed.any()
+    # a mixed formulation's mean stress (Kirchhoff) decides instead
+    h0 = m.initial_history((1,))
+    r = m.update(F(1.0), h0, mean_stress=np.array([1.01 * f_t]))
+    assert r.failed.all()
+    assert CriticalStressDamage.from_fracture_energy(
+        22.17, 190e3, 1.0).strength == pytest.approx(
+            np.sqrt(2 * 22.17 * 190e3))
+    with pytest.raises(ValueError, match="positive"):
+        CriticalStressDamage(-1.0)
+
+
 @pytest.mark.parametrize("element", ["Q1P0", "UnlP0"])
 def test_mean_dilatation_carries_damage_as_the_displacement_law(element):
     """Q1P0 (and PBG UnlP0) under a homogeneous stretch in plane strain:

@@ -194,7 +194,7 @@ class Hyperelastic:
         return None if r is None else self._point_integral(r)
 
     def _point_integral(self, r):
-        """:math:`\sum w\, r` of point data ``r`` over
+        r""":math:`\sum w\, r` of point data ``r`` over
         :attr:`point_basis` (its :class:`Elements` cached: the explicit
         driver asks for the closure every step)."""
         E = getattr(self, "_point_elements", None)

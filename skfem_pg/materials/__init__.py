@@ -7,8 +7,8 @@ from .hyperelastic import (Material, LinearElastic, StVenantKirchhoff,
                            NeoHooke, NeoHookeIsoVol, inverse_and_det)
 from .plasticity import J2Plasticity, ReturnMapError
 from .hardening import LinearSaturation, JohnsonCookHardening
-from .damage import (CriticalStrainDamage, JohnsonCookDamage,
-                     NonlocalStrainDamage)
+from .damage import (CriticalStrainDamage, CriticalStressDamage,
+                     JohnsonCookDamage, NonlocalStrainDamage)
 from .library import FElupeMaterial
 from .viscous import NewtonianFluid, NoRateError
 
@@ -16,5 +16,6 @@ __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
            "inverse_and_det", "J2Plasticity", "ReturnMapError",
            "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage",
-           "CriticalStrainDamage", "NonlocalStrainDamage", "FElupeMaterial",
+           "CriticalStrainDamage", "CriticalStressDamage",
+           "NonlocalStrainDamage", "FElupeMaterial",
            "NewtonianFluid", "NoRateError"]

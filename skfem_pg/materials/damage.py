@@ -1,7 +1,9 @@
 r"""Damage laws for the J2 material: an uncoupled damage indicator
 :math:`D` at every integration point that accumulates with the plastic
-strain and fails the point at a critical value (thesis 8.1); and a
-brittle criterion on the elastic strain (:class:`CriticalStrainDamage`).
+strain and fails the point at a critical value (thesis 8.1); and
+brittle criteria on the elastic strain (:class:`CriticalStrainDamage`,
+:class:`NonlocalStrainDamage`) and on the stress
+(:class:`CriticalStressDamage`).
 
 :class:`JohnsonCookDamage` is Johnson and Cook's (1985) law without rate
 and temperature terms, as the thesis uses it:
@@ -142,6 +144,73 @@ class CriticalStrainDamage:
         symmetric ``b`` ``(n, 3, 3)``."""
         lam = np.linalg.eigvalsh(b)[:, -1]
         return 0.5 * np.log(lam) / self.critical_strain
+
+
+class CriticalStressDamage:
+    r"""A brittle failure criterion on the stress (Rankine's): a point
+    fails when its largest principal Cauchy stress reaches the tensile
+    ``strength`` :math:`f_t`,
+
+    .. math:: D = \max_{steps} \frac{\sigma_{max}}{f_t}, \qquad
+              \text{failure at } D \ge D_c = 1,
+
+    the point's stress before it fails (the plain law's; a mixed
+    formulation's pressure where it gives one) [not in the thesis; the
+    smeared counterpart of the maximum tangential stress criterion of
+    Erdogan & Sih (1963), which sets a crack's direction normal to the
+    largest principal stress at its tip].  Where
+    :class:`CriticalStrainDamage` compares the largest principal strain,
+    which a compression across it raises by Poisson's ratio
+    (:math:`\varepsilon_1 = (\sigma_1 - \nu' \sigma_2)/E'`, with
+    :math:`\nu' = \nu/(1 - \nu) = 0.43` in plane strain at
+    :math:`\nu = 0.3`), this one compares the stress alone.  A failed
+    point is :class:`~skfem_pg.materials.J2Plasticity`'s (no deviatoric
+    stress, no tension).  For a fracture energy :math:`G_0` and a crack
+    one particle spacing :math:`h` wide, :meth:`from_fracture_energy`
+    gives :math:`f_t = \sqrt{2 G_0 E / h}` (the energy of a linear
+    elastic band of width h stressed to :math:`f_t` uniaxially equals
+    :math:`G_0` per unit crack area; :math:`E' = E/(1 - \nu^2)` in plane
+    strain) [crack-band scaling, a choice; the same strength as
+    :class:`CriticalStrainDamage`'s in uniaxial stress].
+
+    >>> law = CriticalStressDamage(500.0)
+    >>> float(law.stress_indicator(np.diag([600.0, -900.0, 0.0])[None],
+    ...                            np.ones(1))[0])
+    1.2
+    """
+
+    Dc = 1.0
+
+    def __init__(self, strength):
+        (self.strength,) = check_finite("CriticalStressDamage",
+                                        strength=strength)
+        if not self.strength > 0:
+            raise ValueError("CriticalStressDamage: the strength must be "
+                             "positive, got {}".format(strength))
+
+    @classmethod
+    def from_fracture_energy(cls, G0, E, h):
+        r"""The strength :math:`\sqrt{2 G_0 E / h}` of a crack band of
+        width ``h`` (class docstring)."""
+        G0, E, h = check_finite("CriticalStressDamage", G0=G0, E=E, h=h)
+        if not (G0 > 0 and E > 0 and h > 0):
+            raise ValueError("CriticalStressDamage: G0, E and h must be "
+                             "positive, got {}, {}, {}".format(G0, E, h))
+        return cls(np.sqrt(2.0 * G0 * E / h))
+
+    def __repr__(self):
+        return "CriticalStressDamage(strength={:g})".format(self.strength)
+
+    def increment(self, dalpha, triaxiality):
+        """No accumulation with the plastic strain."""
+        return np.zeros(np.shape(dalpha))
+
+    def stress_indicator(self, tau, J):
+        r""":math:`\sigma_{max} / f_t` of the Kirchhoff stresses ``tau``
+        ``(n, 3, 3)`` at the volume ratios ``J`` ``(n,)`` (the Cauchy
+        stress is :math:`\tau / J`)."""
+        return np.linalg.eigvalsh(tau)[:, -1] / (
+            np.asarray(J, dtype=float) * self.strength)
 
 
 def triaxiality(tau_dev, mean):

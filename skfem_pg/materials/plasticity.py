@@ -516,8 +516,16 @@ class Response:
                                             triaxiality(tau_full[p],
                                                         mean[p]))
         strain_law = getattr(m.damage, "indicator", None)
-        if strain_law is not None:  # a criterion on the elastic strain
-            indicator = strain_law(btr)
+        stress_law = getattr(m.damage, "stress_indicator", None)
+        if strain_law is not None or stress_law is not None:
+            if strain_law is not None:  # a criterion on the elastic strain
+                indicator = strain_law(btr)
+            else:  # on the stress before failure (a mixed formulation's
+                # pressure where it gives one)
+                tau = tau_full.copy()
+                for i in range(3):
+                    tau[:, i, i] += mean
+                indicator = stress_law(tau, J)
             if getattr(m.damage, "radius", None) is not None:
                 if average is None:
                     raise ValueError(

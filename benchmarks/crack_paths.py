@@ -1,0 +1,103 @@
+"""Do the cracks go where the experiment's go, on any mesh?  The crack
+direction of Kalthoff–Winkler's test on square grids and gmsh triangles
+at two spacings (issue 51).
+
+The plate, the impact and the models of ``demos/kalthoff_winkler.py``
+(maraging steel hit between its notches at 16.5 m/s, 90 µs): the
+bond-based PMB, PG ``VCBCPBG V5sn Unl`` with its connectivity kept and
+with crack-aware families (their default local VC), each with the
+crack-band brittle criterion on the largest principal strain
+(:class:`~skfem_pg.materials.CriticalStrainDamage`) and on the largest
+principal stress (:class:`~skfem_pg.materials.CriticalStressDamage`), on the demo's square grid (the notches cut out as one
+row of cells; PMB cuts the bonds across them) and on gmsh triangles
+(``meshes/kalthoff_winkler.geo``: notches 1 mm wide), at spacings 2 and
+1 mm.  Each crack's direction to its notch is the chord from the notch
+tip to the centroid of the crack's points 10–30 mm from the tip (the
+experiment's about 70 degrees is the initial direction) and 40–60 mm from
+it; the crack's points are the failed cells' centres (PG) or the
+particles more than a third broken (PMB).  Beside them the failed cells
+(PMB: particles), the drivers' energy balance, the steps and the seconds
+of each run, and its seconds over PMB's on the same nodes.
+
+Run: ``python benchmarks/crack_paths.py --results benchmarks/README.md
+--meshes grid`` and ``... --meshes triangles`` (each its own table, its
+rows written as they come; about 40 min and 90 min on one core each;
+``--spacings`` and ``--models`` select a part).
+"""
+import os
+import sys
+
+from harness import demo_parser, markdown_table, update_results
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                                os.pardir, "demos"))
+from kalthoff_winkler import (EXPERIMENT, FURTHER, INITIAL,  # noqa: E402
+                              run_pg, run_pmb)
+
+T_END = 9e-5
+MODELS = ("PMB", "PG kept, strain", "PG kept, stress",
+          "PG crack-aware, strain", "PG crack-aware, stress")
+HEADER = ["run", "mesh", "h (mm)", "particles",
+          "initial, upper / lower (deg)", "further, upper / lower (deg)",
+          "failed", "drivers' balance", "steps", "s", "s / PMB's"]
+
+
+def run(model, mesh, h):
+    """One run: the table's cells after the first three."""
+    if model == "PMB":
+        (upper, lower), tr, m, basis, seconds = run_pmb(h, T_END, mesh)
+        failed = int((m.damage() > 1 / 3).sum())
+        n, balance, steps = (basis.particles.n,
+                             tr.history[-1]["relative_error"], tr.steps)
+    else:
+        (upper, lower), failed, balance, steps, seconds, m = run_pg(
+            h, T_END, "crack-aware" in model, mesh,
+            model.rsplit(", ", 1)[1])
+        n = m.basis.particles.n
+    return [str(n),
+            "{:.1f} / {:.1f}".format(upper[0], lower[0]),
+            "{:.1f} / {:.1f}".format(upper[1], lower[1]),
+            str(failed), "{:+.1e}".format(balance), str(steps),
+            "{:.1f}".format(seconds)], seconds
+
+
+def main(meshes, spacings, models, results=None):
+    rows = []
+    for mesh in meshes:
+        for h in spacings:
+            pmb = None
+            for model in models:
+                cells, seconds = run(model, mesh, h)
+                if model == "PMB":
+                    pmb = seconds
+                rows.append([model, mesh, "{:g}".format(h)] + cells + [
+                    "" if pmb is None else "{:.1f}".format(seconds / pmb)])
+                print(" | ".join(rows[-1]), flush=True)
+                text = (
+                    "Kalthoff–Winkler to {:g} µs on {}: the crack's "
+                    "direction to the notch from each notch tip (upper / "
+                    "lower), the chord to the centroid of its points "
+                    "{:g}–{:g} mm (initial) and {:g}–{:g} mm (further) from "
+                    "the tip, against the experiment's about {:.0f} degrees "
+                    "(initial); PG's criterion on the largest principal "
+                    "strain or stress:\n\n".format(
+                        T_END * 1e6, " and ".join(meshes), *INITIAL,
+                        *FURTHER, EXPERIMENT)
+                    + markdown_table(HEADER, rows))
+                if results:  # row by row: a long run shows what it has
+                    update_results(results, "crack_paths_" + "_".join(
+                        meshes), text)
+    print(text)
+
+
+if __name__ == "__main__":
+    ap = demo_parser(__doc__, results=True, quick=False)
+    ap.add_argument("--meshes", nargs="+", choices=("grid", "triangles"),
+                    default=["grid", "triangles"],
+                    help="the node sets (one table for those given)")
+    ap.add_argument("--spacings", nargs="+", type=float, default=[2.0, 1.0],
+                    help="particle spacings in mm")
+    ap.add_argument("--models", nargs="+", choices=MODELS,
+                    default=list(MODELS), help="the models, in this order")
+    args = ap.parse_args()
+    main(args.meshes, args.spacings, args.models, args.results)
