@@ -151,8 +151,8 @@ SCRIPTS = [
      "Kalthoff–Winkler's crack direction on square grids and gmsh "
      "triangles at 2 and 1 mm: PMB, PG kept and crack-aware with the "
      "strain and the stress criterion, against the experiment's 70 "
-     "degrees (grids and triangles in two processes, 2026-12-07)",
-     "2 h", 7200),
+     "degrees (grids 41 min and triangles 73 min, in two processes beside "
+     "other jobs, 2026-12-07)", "75 min", 4500),
     ("factor_reuse", ["benchmarks/factor_reuse.py"],
      "modified Newton (reuse=True) against full Newton: whole solves of "
      "the 3-D Cook, a bracket, necking, the punch", "5 min", 600),

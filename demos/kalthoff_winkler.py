@@ -39,16 +39,16 @@ to the centroid of the crack's points (particles more than a third
 broken; for PG the failed cells' centres) 10-30 mm from the tip, the
 initial direction that the experiment's 70 degrees describes, and 40-60
 mm from it; beside them the broken bonds or failed cells and the energy
-balance.  Measured on the square grid (``benchmarks/crack_paths.py``,
-initial / further): PMB 69.2 / 72.3 (2 mm) and 72.4 / 72.3 (1 mm); PG kept
-64.1 / 60.2 and 64.7 / 60.8; on gmsh triangles at 2 mm PMB 60.1 and 56.1
-(upper and lower), PG kept 56.0 / 55.6: every model's crack runs at
-55-65 degrees on triangles, ten below the experiment's.  Crack-aware
-(its default local VC) climbs the column of cells above the notch tip on
-the grid (82 / 85 at 2 mm).  The far edge also cracks where the
-reflected wave turns tensile (a known feature of 2-D models of this
-test); the directions leave that region out (they use the points above
-the upper notch and below the lower one).  Writes
+balance.  Measured (``benchmarks/crack_paths.py``, initial directions):
+on the square grid PMB 69 degrees at 2 mm and 72 at 1 mm, PG kept 64 and
+65 (strain criterion) or 69 and 73 (stress criterion), crack-aware
+82-88 (it climbs the column of cells above the notch tip); on gmsh
+triangles every model changes with the spacing: PMB 56-60 at 2 mm and
+68-70 at 1 mm, PG kept 56-60 and 75-85 (at 1 mm its crack starts up the
+notch's face), crack-aware 56-68 and 72-74.  The far edge also cracks
+where the reflected wave turns tensile (a known feature of 2-D models of
+this test); the directions leave that region out (they use the points
+above the upper notch and below the lower one).  Writes
 ``out/kalthoff_winkler.png`` and ``out/kalthoff_winkler.vtu`` (damage).
 
     python demos/kalthoff_winkler.py [--dx 1.0] [--pg-dx 2.0] [--mesh grid]
