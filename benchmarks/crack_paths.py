@@ -8,8 +8,9 @@ bond-based PMB, PG ``VCBCPBG V5sn Unl`` with its connectivity kept and
 with crack-aware families (their default local VC), each with the
 crack-band brittle criterion on the largest principal strain
 (:class:`~skfem_pg.materials.CriticalStrainDamage`) and on the largest
-principal stress (:class:`~skfem_pg.materials.CriticalStressDamage`), on the demo's square grid (the notches cut out as one
-row of cells; PMB cuts the bonds across them) and on gmsh triangles
+principal stress (:class:`~skfem_pg.materials.CriticalStressDamage`),
+on the demo's square grid (the notches cut out as one row of cells; PMB
+cuts the bonds across them) and on gmsh triangles
 (``meshes/kalthoff_winkler.geo``: notches 1 mm wide), at spacings 2 and
 1 mm.  Each crack's direction to its notch is the chord from the notch
 tip to the centroid of the crack's points 10–30 mm from the tip (the
@@ -21,7 +22,8 @@ of each run, and its seconds over PMB's on the same nodes.
 
 Run: ``python benchmarks/crack_paths.py --results benchmarks/README.md
 --meshes grid`` and ``... --meshes triangles`` (each its own table, its
-rows written as they come; about 40 min and 90 min on one core each;
+rows written as they come; 41 and 73 min measured, side by side on 2
+cores;
 ``--spacings`` and ``--models`` select a part).
 """
 import os

@@ -155,8 +155,8 @@ def run_pmb(dx, t_end, mesh="grid", verbose=False):
     model, basis, seconds)``; its crack is the particles more than a
     third broken."""
     t0 = time.perf_counter()
-    y_notch = notched_plate(dx, mesh)[2]
-    basis = pg.FamilyBasis(notched_plate(dx, mesh)[1], dim=2)
+    _, full, y_notch = notched_plate(dx, mesh)
+    basis = pg.FamilyBasis(full, dim=2)
 
     def notches(Xi, Xj):
         return (segment_cut((-1.0, y_notch), (NOTCH, y_notch))(Xi, Xj)
