@@ -267,19 +267,14 @@ class _MasterModel(Hyperelastic):
             a = np.zeros(len(self._master_flat))
         return np.array(a), float(a.max(initial=0.0))
 
-    def fracture_energy(self):
-        """The energy the failed masters released (:math:`\\sum_k V^k`
-        times their density), ``None`` without a damage law."""
-        r = None if self.history is None else self.history.released()
-        return None if r is None else self._master_energy(r)
-
-    def closure_energy(self):
-        """The closure energy of the failed masters, ``None`` without a
-        damage law (as
-        :meth:`Hyperelastic.closure_energy
-        <skfem_pg.formulations.Hyperelastic.closure_energy>`)."""
-        r = None if self.history is None else self.history.closure()
-        return None if r is None else self._master_energy(r)
+    def _point_integral(self, r):
+        """Point data at the masters integrated, :math:`\\sum_k V^k r^k`
+        (:meth:`_master_energy`): the released and the closure energy of
+        :meth:`Hyperelastic.fracture_energy
+        <skfem_pg.formulations.Hyperelastic.fracture_energy>` and
+        :meth:`~skfem_pg.formulations.Hyperelastic.closure_energy` over the
+        failed masters."""
+        return self._master_energy(r)
 
     def _master_force(self, P1):
         r""":math:`\sum_k V^k P^k : \delta F^{kk}` (the U1 weights sum to

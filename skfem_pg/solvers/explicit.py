@@ -59,7 +59,6 @@ from .problem import Problem
 from ..discretization.particles import inverted_cells
 
 
-
 #: a stable-step estimate is repeated at once when a point has been
 #: compressed by more than this factor since the last one
 REESTIMATE = 1.25
