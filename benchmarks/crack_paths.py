@@ -16,7 +16,12 @@ cuts the bonds across them) and on gmsh triangles
 tip to the centroid of the crack's points 10–30 mm from the tip (the
 experiment's about 70 degrees is the initial direction) and 40–60 mm from
 it; the crack's points are the failed cells' centres (PG) or the
-particles more than a third broken (PMB).  Beside them the failed cells
+particles more than a third broken (PMB).  ``--tracked`` runs PG with the
+crack tracking instead (:class:`~skfem_pg.materials.CrackTracking`: a
+point fails only on the path a crack tip chooses by the maximum
+tangential stress criterion; the notch tips given), beside PMB, into its
+own table (a run its ``hold_limit`` stops is reported as stopped, with
+what it held).  Beside them the failed cells
 (PMB: particles), the drivers' energy balance, the steps and the seconds
 of each run, and its seconds over PMB's on the same nodes.
 
@@ -24,10 +29,12 @@ Run: ``python benchmarks/crack_paths.py --results benchmarks/README.md
 --meshes grid`` and ``... --meshes triangles`` (each its own table, its
 rows written as they come; 41 and 73 min measured, side by side on 2
 cores;
-``--spacings`` and ``--models`` select a part).
+``--spacings`` and ``--models`` select a part; ``--tracked``, the same
+for each mesh).
 """
 import os
 import sys
+import time
 
 from harness import demo_parser, markdown_table, update_results
 
@@ -35,10 +42,16 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)),
                                 os.pardir, "demos"))
 from kalthoff_winkler import (EXPERIMENT, FURTHER, INITIAL,  # noqa: E402
                               run_pg, run_pmb)
+from skfem_pg.discretization.crack_tracking import \
+    TrackingError  # noqa: E402
 
 T_END = 9e-5
 MODELS = ("PMB", "PG kept, strain", "PG kept, stress",
           "PG crack-aware, strain", "PG crack-aware, stress")
+#: ``--tracked``: the criteria with the crack tracking
+#: (:class:`~skfem_pg.materials.CrackTracking`, the notch tips given)
+TRACKED = ("PMB", "PG kept, stress, tracked",
+           "PG crack-aware, stress, tracked")
 HEADER = ["run", "mesh", "h (mm)", "particles",
           "initial, upper / lower (deg)", "further, upper / lower (deg)",
           "failed", "drivers' balance", "steps", "s", "s / PMB's"]
@@ -52,9 +65,20 @@ def run(model, mesh, h):
         n, balance, steps = (basis.particles.n,
                              tr.history[-1]["relative_error"], tr.steps)
     else:
-        (upper, lower), failed, balance, steps, seconds, m = run_pg(
-            h, T_END, "crack-aware" in model, mesh,
-            model.rsplit(", ", 1)[1])
+        t0 = time.perf_counter()
+        try:
+            (upper, lower), failed, balance, steps, seconds, m = run_pg(
+                h, T_END, "crack-aware" in model, mesh,
+                model.split(", ")[1], tracked=model.endswith("tracked"))
+        except TrackingError as err:  # the tracking's own check stopped it
+            seconds = time.perf_counter() - t0
+            text = str(err)
+            ratio = text.split("at up to ")[1].split(" times")[0]
+            where = text.split(" in the reference")[0].rsplit(
+                "(", 1)[1].rstrip(")")
+            return ["", "stopped: a point held at {} x its criterion at "
+                    "({})".format(ratio, where), "", "", "", "",
+                    "{:.1f}".format(seconds)], seconds
         n = m.basis.particles.n
     return [str(n),
             "{:.1f} / {:.1f}".format(upper[0], lower[0]),
@@ -63,7 +87,7 @@ def run(model, mesh, h):
             "{:.1f}".format(seconds)], seconds
 
 
-def main(meshes, spacings, models, results=None):
+def main(meshes, spacings, models, results=None, section="crack_paths_"):
     rows = []
     for mesh in meshes:
         for h in spacings:
@@ -87,8 +111,8 @@ def main(meshes, spacings, models, results=None):
                         *FURTHER, EXPERIMENT)
                     + markdown_table(HEADER, rows))
                 if results:  # row by row: a long run shows what it has
-                    update_results(results, "crack_paths_" + "_".join(
-                        meshes), text)
+                    update_results(results, section + "_".join(meshes),
+                                   text)
     print(text)
 
 
@@ -99,7 +123,12 @@ if __name__ == "__main__":
                     help="the node sets (one table for those given)")
     ap.add_argument("--spacings", nargs="+", type=float, default=[2.0, 1.0],
                     help="particle spacings in mm")
-    ap.add_argument("--models", nargs="+", choices=MODELS,
-                    default=list(MODELS), help="the models, in this order")
+    ap.add_argument("--models", nargs="+", choices=MODELS + TRACKED[1:],
+                    default=None, help="the models, in this order")
+    ap.add_argument("--tracked", action="store_true",
+                    help="PMB beside PG with the crack tracking (its own "
+                         "table, crack_paths_tracked_<meshes>)")
     args = ap.parse_args()
-    main(args.meshes, args.spacings, args.models, args.results)
+    models = args.models or list(TRACKED if args.tracked else MODELS)
+    main(args.meshes, args.spacings, models, args.results,
+         "crack_paths_tracked_" if args.tracked else "crack_paths_")

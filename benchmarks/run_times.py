@@ -152,7 +152,9 @@ SCRIPTS = [
      "triangles at 2 and 1 mm: PMB, PG kept and crack-aware with the "
      "strain and the stress criterion, against the experiment's 70 "
      "degrees (grids 41 min and triangles 73 min, in two processes beside "
-     "other jobs, 2026-12-07)", "75 min", 4500),
+     "other jobs, 2026-12-07); `--tracked`: PMB beside PG with the crack "
+     "tracking (grids 4 min and triangles 5 min, side by side: the PG "
+     "runs stop on the tracking's check)", "75 min", 4500),
     ("factor_reuse", ["benchmarks/factor_reuse.py"],
      "modified Newton (reuse=True) against full Newton: whole solves of "
      "the 3-D Cook, a bracket, necking, the punch", "5 min", 600),

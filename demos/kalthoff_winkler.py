@@ -32,7 +32,11 @@ step is 19 times smaller (3.4e-8 against 6.5e-7 s at 4 mm).
 instead (``meshes/kalthoff_winkler.geo``: notches 1 mm wide); ``run_pg``
 takes the criterion on the largest principal stress too
 (:class:`~skfem_pg.materials.CriticalStressDamage`, the same uniaxial
-strength; ``benchmarks/crack_paths.py`` runs both).
+strength; ``--criterion stress``; ``benchmarks/crack_paths.py`` runs
+both), and ``--tracked`` runs it with the crack tracking
+(:class:`~skfem_pg.materials.CrackTracking`: a point fails only on the
+path a crack tip chooses by the maximum tangential stress criterion, the
+notch tips given as crack tips).
 
 Prints each crack's direction to its notch: the chord from the notch tip
 to the centroid of the crack's points (particles more than a third
@@ -52,7 +56,7 @@ above the upper notch and below the lower one).  Writes
 ``out/kalthoff_winkler.png`` and ``out/kalthoff_winkler.vtu`` (damage).
 
     python demos/kalthoff_winkler.py [--dx 1.0] [--pg-dx 2.0] [--mesh grid]
-        [--t-end 9e-5]
+        [--t-end 9e-5] [--criterion strain] [--tracked]
 """
 import os
 import time
@@ -64,8 +68,8 @@ import skfem_pg as pg
 from skfem_pg.formulations import BondBased, CrackAware, model_for, \
     segment_cut
 from skfem_pg.formulations.crack_aware import cell_failure
-from skfem_pg.materials import (CriticalStrainDamage, CriticalStressDamage,
-                                J2Plasticity)
+from skfem_pg.materials import (CrackTracking, CriticalStrainDamage,
+                                CriticalStressDamage, J2Plasticity)
 from skfem_pg.scenes.meshing import from_geo, geo_path
 from harness import demo_parser, new_figure, output_dir, save_figure
 
@@ -173,14 +177,20 @@ def run_pmb(dx, t_end, mesh="grid", verbose=False):
             time.perf_counter() - t0)
 
 
-def run_pg(dx, t_end, crack_aware, mesh="grid", criterion="strain"):
+def run_pg(dx, t_end, crack_aware, mesh="grid", criterion="strain",
+           tracked=False, hold_limit=2.0):
     """The plate with PG Unl and a brittle criterion on the ``"strain"``
-    or the ``"stress"`` (module docstring): ``(directions, failed cells,
-    energy balance, steps, seconds, model)``; its crack is the failed
-    cells' centres."""
+    or the ``"stress"`` (module docstring), ``tracked``: with the crack
+    tracking (:class:`~skfem_pg.materials.CrackTracking`, its
+    ``hold_limit``): ``(directions, failed cells, energy balance, steps,
+    seconds, model)``; its crack is the failed cells' centres."""
     t0 = time.perf_counter()
     mesh, _, y_notch = notched_plate(dx, mesh)
     law = CRITERIA[criterion].from_fracture_energy(G0, E / (1 - NU ** 2), dx)
+    if tracked:  # the notch tips are crack tips from the start
+        law = CrackTracking(law, notches=[
+            ((NOTCH, y), (1.0, 0.0)) for y in (y_notch, -y_notch)],
+            hold_limit=hold_limit)
     steel = J2Plasticity.from_young(E, NU, 1e9, damage=law)  # elastic
     basis = pg.FamilyBasis.from_name(mesh, "VCBCPBG V5sn Unl", dim=2)
     model = (CrackAware(basis, steel) if crack_aware
@@ -214,6 +224,12 @@ def main():
                     help="the node sets: square grids or gmsh triangles")
     ap.add_argument("--t-end", type=float, default=9e-5,
                     help="end time in seconds")
+    ap.add_argument("--criterion", choices=tuple(CRITERIA), default="strain",
+                    help="PG's brittle criterion: the largest principal "
+                         "strain or stress")
+    ap.add_argument("--tracked", action="store_true",
+                    help="PG with the crack tracking (CrackTracking, the "
+                         "notch tips given)")
     args = ap.parse_args()
     if args.quick:
         args.dx, args.pg_dx = 2.0, 4.0
@@ -235,12 +251,14 @@ def main():
                  u=tr.x[:basis.N], damage=damage)
     runs = []
     for aware in ((False, True) if args.pg_dx > 0 else ()):
-        r = run_pg(args.pg_dx, args.t_end, aware, args.mesh)
+        r = run_pg(args.pg_dx, args.t_end, aware, args.mesh,
+                   args.criterion, args.tracked)
         runs.append((aware, r))
-        print("PG Unl, {}, dx = {:g} mm: upper {:.1f} / {:.1f}, lower "
-              "{:.1f} / {:.1f} degrees; {} failed cells; energy balance "
-              "{:.2e}; {} steps, {:.1f} s".format(
+        print("PG Unl, {}, {} criterion{}, dx = {:g} mm: upper {:.1f} / "
+              "{:.1f}, lower {:.1f} / {:.1f} degrees; {} failed cells; "
+              "energy balance {:.2e}; {} steps, {:.1f} s".format(
                   "crack-aware" if aware else "connectivity kept",
+                  args.criterion, ", tracked" if args.tracked else "",
                   args.pg_dx, *r[0][0], *r[0][1], r[1], r[2], r[3], r[4]))
     fig, axes = new_figure(1 + len(runs), figsize=(4.5 * (1 + len(runs)),
                                                    7))

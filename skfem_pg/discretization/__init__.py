@@ -35,6 +35,9 @@ systems.
 ``coefficients``           piecewise (per-cell) coefficients at the members
 ``nonlocal_mean``          :class:`~skfem_pg.discretization.nonlocal_mean.
                            NonlocalAverage`: bell means over a model's points
+``crack_tracking``         :class:`~skfem_pg.discretization.crack_tracking.
+                           CrackTracker`: which points a tracked brittle
+                           criterion may fail (2-D)
 =========================  ====================================================
 """
 from .particles import Particles

@@ -35,6 +35,27 @@ def _bell(x, radius, volumes):
     return sp.csr_matrix((a, (i, j)), shape=(n, n))
 
 
+def point_sites(basis):
+    """Where a model's integration points on ``basis`` lie: ``(at, x,
+    volumes, gather)``.  On a family basis the sites are the particles:
+    ``at`` the points' particles (the members of the flat layout), ``x``
+    ``(d, n)`` and ``volumes`` the particles', ``gather`` the sparse
+    ``(n, N_q)`` matrix of the points' weights (row i: the points at
+    particle i).  On a scikit-fem basis every Gauss point is its own site:
+    ``at`` and ``gather`` are ``None``, ``x`` the Gauss points and
+    ``volumes`` their ``dx``."""
+    if is_family_basis(basis):
+        particles = basis.particles
+        at = basis.families.members
+        w = basis.flat_weights().ravel()
+        gather = sp.csr_matrix((w, (at, np.arange(at.size))),
+                               shape=(particles.n, at.size))
+        return at, particles.x, particles.volumes, gather
+    x = np.asarray(basis.global_coordinates())
+    return (None, x.reshape(x.shape[0], -1),
+            np.asarray(basis.dx, dtype=float).ravel(), None)
+
+
 class NonlocalAverage:
     """The masked bell mean of radius ``radius`` over the integration
     points of ``basis`` (module docstring): ``average(values, mask)``
@@ -67,23 +88,8 @@ class NonlocalAverage:
             raise ValueError("NonlocalAverage: the radius must be positive, "
                              "got {}".format(radius))
         self.basis, self.radius = basis, float(radius)
-        if is_family_basis(basis):
-            particles = basis.particles
-            self.at = basis.families.members  # the points' particles
-            w = basis.flat_weights().ravel()
-            n = particles.n
-            # the points' masked mean at each particle: rows of P
-            self._gather = sp.csr_matrix(
-                (w, (self.at, np.arange(self.at.size))),
-                shape=(n, self.at.size))
-            self._bell = _bell(particles.x, self.radius, particles.volumes)
-        else:  # a scikit-fem basis: its Gauss points
-            x = np.asarray(basis.global_coordinates())
-            x = x.reshape(x.shape[0], -1)
-            self.at = None
-            self._gather = None
-            self._bell = _bell(x, self.radius, np.asarray(
-                basis.dx, dtype=float).ravel())
+        self.at, x, volumes, self._gather = point_sites(basis)
+        self._bell = _bell(x, self.radius, volumes)
         self.n_points = (self.at.size if self.at is not None
                          else self._bell.shape[0])
 

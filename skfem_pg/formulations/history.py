@@ -26,6 +26,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
+from ..discretization.crack_tracking import CrackTracker
 from ..discretization.nonlocal_mean import NonlocalAverage
 
 
@@ -48,6 +49,7 @@ class History:
         self._last = None  # (F, response)
         self._mean = None  # (F, mean stress): bind_mean_stress
         self._average = None  # a NonlocalAverage, for its basis
+        self._tracker = None  # a CrackTracker, for its basis
 
     def __repr__(self):
         return "History({!r})".format(self.material)
@@ -81,22 +83,30 @@ class History:
         kw = {}
         if self._mean is not None and self._mean[0] is F:
             kw["mean_stress"] = self._mean[1]
-        radius = getattr(getattr(self.material, "damage", None), "radius",
-                         None)
+        damage = getattr(self.material, "damage", None)
+        radius = getattr(damage, "radius", None)
         if radius is not None:
-            kw["average"] = a = self.nonlocal_average(radius)
-            n = int(np.prod(F.shape[2:]))
-            if n != a.n_points:
-                raise ValueError(
-                    "{!r}: the model evaluates its material at {} points, "
-                    "its point basis has {} integration points (a "
-                    "formulation with the material at the masters, as "
-                    "U1SIG): the nonlocal mean is built for the PG and FE "
-                    "displacement and mean-dilatation models".format(
-                        self.material.damage, n, a.n_points))
+            kw["average"] = self._on_points(
+                self.nonlocal_average(radius), F, "the nonlocal mean")
+        if getattr(damage, "tracking", False):
+            kw["tracker"] = self._on_points(self.crack_tracker(), F,
+                                            "crack tracking")
         r = self.material.update(F, self.committed, **kw)
         self._last = (F, r)
         return r
+
+    def _on_points(self, over, F, what):
+        """``over`` (a nonlocal mean or a crack tracker over the point
+        basis), checked against the points ``F`` lives at."""
+        n = int(np.prod(F.shape[2:]))
+        if n != over.n_points:
+            raise ValueError(
+                "{!r}: the model evaluates its material at {} points, its "
+                "point basis has {} integration points (a formulation with "
+                "the material at the masters, as U1SIG): {} is built for "
+                "the PG and FE displacement and mean-dilatation models"
+                .format(self.material.damage, n, over.n_points, what))
+        return over
 
     def nonlocal_average(self, radius):
         """The :class:`~skfem_pg.discretization.nonlocal_mean.
@@ -112,6 +122,21 @@ class History:
         if a is None or a.basis is not basis or a.radius != radius:
             self._average = a = NonlocalAverage(basis, radius)
         return a
+
+    def crack_tracker(self):
+        """The :class:`~skfem_pg.discretization.crack_tracking.
+        CrackTracker` of the material's tracked damage law over the points
+        (built again when the model's point basis changes)."""
+        basis = None if self.points is None else self.points()
+        law = self.material.damage
+        if basis is None:
+            raise ValueError(
+                "{!r} tracks its crack, and this History was not given its "
+                "points (History(material, points=...))".format(law))
+        t = self._tracker
+        if t is None or t.basis is not basis or t.law is not law:
+            self._tracker = t = CrackTracker(basis, law)
+        return t
 
     # the stateless-material interface the formulations call
     def stress(self, F):

@@ -7,8 +7,9 @@ from .hyperelastic import (Material, LinearElastic, StVenantKirchhoff,
                            NeoHooke, NeoHookeIsoVol, inverse_and_det)
 from .plasticity import J2Plasticity, ReturnMapError
 from .hardening import LinearSaturation, JohnsonCookHardening
-from .damage import (CriticalStrainDamage, CriticalStressDamage,
-                     JohnsonCookDamage, NonlocalStrainDamage)
+from .damage import (CrackTracking, CriticalStrainDamage,
+                     CriticalStressDamage, JohnsonCookDamage,
+                     NonlocalStrainDamage)
 from .library import FElupeMaterial
 from .viscous import NewtonianFluid, NoRateError
 
@@ -16,6 +17,6 @@ __all__ = ["check_moduli", "lame", "Material", "LinearElastic",
            "StVenantKirchhoff", "NeoHooke", "NeoHookeIsoVol",
            "inverse_and_det", "J2Plasticity", "ReturnMapError",
            "LinearSaturation", "JohnsonCookHardening", "JohnsonCookDamage",
-           "CriticalStrainDamage", "CriticalStressDamage",
+           "CriticalStrainDamage", "CriticalStressDamage", "CrackTracking",
            "NonlocalStrainDamage", "FElupeMaterial",
            "NewtonianFluid", "NoRateError"]

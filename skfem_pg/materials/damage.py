@@ -213,6 +213,130 @@ class CriticalStressDamage:
             np.asarray(J, dtype=float) * self.strength)
 
 
+class CrackTracking:
+    r"""A brittle criterion (:class:`CriticalStrainDamage` or
+    :class:`CriticalStressDamage`) that fails only the points on the path
+    a crack tip chooses: the crack tracking of Cervera & Chiumenti (2006)
+    with the tip's direction from the maximum tangential stress criterion
+    of Erdogan & Sih (1963) [not in the thesis; issue 51].  A local
+    criterion fails the point where the stress is largest; next to a sharp
+    notch under shear that is the notch face, and the crack follows the
+    mesh (Kalthoff–Winkler on triangles).  Tracked, a point may fail only
+    on the path ahead of a crack tip, which turns by the kink the
+    criterion gives for the stress intensity factors fitted to the intact
+    sites around the tip, beside the crack within its ``width``, or far
+    from every crack (a new one); :class:`~skfem_pg.discretization.
+    crack_tracking.CrackTracker` has the algorithm.  The lengths are in
+    units of each site's spacing :math:`\sqrt{V}` (a particle's volume).
+    2-D, serial; a formulation that binds its points evaluates it (the PG
+    and FE displacement and mean-dilatation models, crack-aware ones
+    included).  Experimental: on Kalthoff–Winkler every PG run holds
+    points beside its crack at more than twice their strength and stops
+    on ``hold_limit``; lifted, its paths change with the spacing
+    (``benchmarks/README.md``).
+
+    Parameters
+    ----------
+    law
+        The criterion: when a point fails.
+    width
+        The crack's width about the line its tip chose, within which the
+        sites beside it may fail (spacings); with the connectivity kept a
+        band two sites wide leaves the families that span it overstressed
+        beside it, and on the square grid the crack stops.
+    reach
+        How far ahead of a tip a site may fail, and within which another
+        crack site closes a crack site's end (spacings).
+    tip_radius
+        The stress intensity factors are fitted to the intact sites
+        between one and this many spacings from the tip.
+    cone
+        The largest turn of a tip's direction from its crack's, in
+        degrees (below 90).
+    exclusion
+        A new crack starts only this many spacings from every crack and
+        notch tip.
+    notches
+        The tips of the notches (or initial cracks) the body has, as pairs
+        ``((x, y), (d_x, d_y))``: the tip and the notch's direction (out
+        of the notch into the material).  A notch tip is a crack tip from
+        the start: the path from it follows the stress around it in the
+        notch's frame.  Without them a crack starts where the criterion is
+        first reached, normal to the largest principal stress there.
+    hold_limit
+        A point held off the path whose criterion exceeds this many times
+        its critical value raises :class:`~skfem_pg.discretization.
+        crack_tracking.TrackingError` (``numpy.inf``: no limit).
+
+    Examples
+    --------
+    >>> CrackTracking(CriticalStressDamage(500.0))  # doctest: +ELLIPSIS
+    CrackTracking(CriticalStressDamage(strength=500), width=3, reach=2, ...)
+    """
+
+    tracking = True
+
+    def __init__(self, law, width=3.0, reach=2.0, tip_radius=3.0,
+                 cone=75.0, exclusion=5.0, notches=(), hold_limit=2.0):
+        if not isinstance(law, (CriticalStrainDamage, CriticalStressDamage)) \
+                or isinstance(law, NonlocalStrainDamage):
+            raise TypeError(
+                "CrackTracking tracks a local brittle criterion "
+                "(CriticalStrainDamage or CriticalStressDamage), got {!r}"
+                .format(law))
+        self.law = law
+        self.width, self.reach, self.tip_radius, self.cone, \
+            self.exclusion = \
+            check_finite("CrackTracking", width=width, reach=reach,
+                         tip_radius=tip_radius, cone=cone,
+                         exclusion=exclusion)
+        self.hold_limit = float(hold_limit)
+        if not self.hold_limit >= 1.0:  # inf: no limit
+            raise ValueError("CrackTracking: hold_limit must be at least 1, "
+                             "got {}".format(hold_limit))
+        for name in ("width", "reach", "tip_radius", "exclusion"):
+            if not getattr(self, name) > 0:
+                raise ValueError("CrackTracking: {} must be positive, got "
+                                 "{}".format(name, getattr(self, name)))
+        if not 0 < self.cone < 90:
+            raise ValueError("CrackTracking: cone must lie in (0, 90) "
+                             "degrees, got {}".format(cone))
+        tips, directions = [], []
+        for k, notch in enumerate(notches):
+            try:
+                tip, d = (np.asarray(a, dtype=float) for a in notch)
+            except (TypeError, ValueError):
+                tip = d = np.zeros(0)
+            if tip.shape != (2,) or d.shape != (2,) or not (
+                    np.all(np.isfinite(tip)) and np.all(np.isfinite(d))
+                    and np.hypot(*d) > 0):
+                raise ValueError(
+                    "CrackTracking: notch {} must be ((x, y), (d_x, d_y)) "
+                    "with finite numbers and a nonzero direction, got {!r}"
+                    .format(k, notch))
+            tips.append(tip)
+            directions.append(d / np.hypot(*d))
+        self.notch_tips = np.array(tips, dtype=float).reshape(-1, 2).T
+        self.notch_directions = np.array(
+            directions, dtype=float).reshape(-1, 2).T
+        self.Dc = law.Dc
+        for name in ("indicator", "stress_indicator"):
+            if hasattr(law, name):
+                setattr(self, name, getattr(law, name))
+
+    def __repr__(self):
+        return ("CrackTracking({!r}, width={:g}, reach={:g}, "
+                "tip_radius={:g}, cone={:g}, exclusion={:g}{})".format(
+                    self.law, self.width, self.reach, self.tip_radius,
+                    self.cone, self.exclusion,
+                    ", {} notches".format(self.notch_tips.shape[1])
+                    if self.notch_tips.shape[1] else ""))
+
+    def increment(self, dalpha, triaxiality):
+        """No accumulation with the plastic strain."""
+        return np.zeros(np.shape(dalpha))
+
+
 def triaxiality(tau_dev, mean):
     r""":math:`\sigma^* = p / \sigma_{vM}` of Kirchhoff (or Cauchy)
     stresses given by their deviators ``tau_dev`` ``(n, 3, 3)`` and mean

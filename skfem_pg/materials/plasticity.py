@@ -233,10 +233,13 @@ class J2Plasticity(Material):
             h["released"] = np.zeros(shape)
             h["F_last"] = Cp.copy()  # the committed F (3-D), identity
             h["closure"] = np.zeros(shape)
+            if getattr(self.damage, "tracking", False):
+                h["crack_line"] = np.zeros((4,) + shape)
         return h
 
     # -- the stress update ---------------------------------------------
-    def update(self, F, history, mean_stress=None, average=None):
+    def update(self, F, history, mean_stress=None, average=None,
+               tracker=None):
         """The response to ``F`` ``(d, d, ...)`` from the committed
         ``history`` at the same points: a :class:`Response` with the
         stress ``P``, the trial history and (on demand) the algorithmic
@@ -245,8 +248,10 @@ class J2Plasticity(Material):
         volumetric one (a mixed formulation's pressure, times J).
         ``average``: the nonlocal mean over the points
         (:class:`~skfem_pg.discretization.nonlocal_mean.NonlocalAverage`),
-        which a nonlocal damage law needs."""
-        return Response(self, F, history, mean_stress, average)
+        which a nonlocal damage law needs; ``tracker``: the crack
+        tracking over the points (:class:`~skfem_pg.discretization.
+        crack_tracking.CrackTracker`), which a tracked one needs."""
+        return Response(self, F, history, mean_stress, average, tracker)
 
     # stateless use (the virgin state): what the elastic formulations and
     # the hyperelastic checks call
@@ -390,7 +395,7 @@ class Response:
     :meth:`energy`."""
 
     def __init__(self, material, F, history, mean_stress=None,
-                 average=None):
+                 average=None, tracker=None):
         self.material = m = material
         self.F = F
         d = F.shape[0]
@@ -456,7 +461,7 @@ class Response:
         if m.damage is not None:
             damage, released, failed, vol = self._damage(
                 history, damage, (alpha, alpha_n), p, tau_full, vol,
-                mean_stress, btr, average)
+                mean_stress, btr, average, tracker)
         self._failed = failed
         self.failed = failed.reshape(self.point_shape)
         for i in range(3):
@@ -476,6 +481,9 @@ class Response:
             self.history["F_last"] = np.moveaxis(self._F3, 0, 2).reshape(
                 (3, 3) + self.point_shape)
             self.history["closure"] = self._closure.reshape(self.point_shape)
+            if self._line is not None:
+                self.history["crack_line"] = self._line.reshape(
+                    (4,) + self.point_shape)
         self._A = None
         self._spectral = None
 
@@ -500,7 +508,7 @@ class Response:
         return da
 
     def _damage(self, history, damage, alphas, p, tau_full, vol,
-                mean_stress, btr, average=None):
+                mean_stress, btr, average=None, tracker=None):
         """``(damage, released, failed, vol)``: the damage law's step at
         the points (thesis 8.1), the energy density released by the
         points failing now, and a failed point's stress (no deviatoric
@@ -517,14 +525,18 @@ class Response:
                                                         mean[p]))
         strain_law = getattr(m.damage, "indicator", None)
         stress_law = getattr(m.damage, "stress_indicator", None)
+        tracked = getattr(m.damage, "tracking", False)
+        self._line = None
         if strain_law is not None or stress_law is not None:
-            if strain_law is not None:  # a criterion on the elastic strain
-                indicator = strain_law(btr)
-            else:  # on the stress before failure (a mixed formulation's
+            if strain_law is None or tracked:
+                # the stress before failure (a mixed formulation's
                 # pressure where it gives one)
                 tau = tau_full.copy()
                 for i in range(3):
                     tau[:, i, i] += mean
+            if strain_law is not None:  # a criterion on the elastic strain
+                indicator = strain_law(btr)
+            else:
                 indicator = stress_law(tau, J)
             if getattr(m.damage, "radius", None) is not None:
                 if average is None:
@@ -536,6 +548,20 @@ class Response:
                 # the nonlocal mean over the intact points
                 indicator = average(indicator, history["damage"].reshape(n)
                                     < m.damage.Dc)
+            if tracked:
+                if tracker is None:
+                    raise ValueError(
+                        "{!r} tracks its crack over a model's points, which "
+                        "the model binds (PG and FE displacement and "
+                        "mean-dilatation models), not by itself".format(
+                            m.damage))
+                line = history.get("crack_line")  # none: a history of
+                # the untracked law (a checkpoint): no lines yet
+                indicator, self._line = tracker(
+                    indicator, tau / J[:, None, None],
+                    history["damage"].reshape(n) >= m.damage.Dc,
+                    np.zeros((4, n)) if line is None
+                    else line.reshape(4, n), m.damage.Dc)
             damage = np.maximum(damage, indicator)
         failed = damage >= m.damage.Dc
         # the energy density a point failing now releases: what it
