@@ -204,8 +204,9 @@ class CrackTracker:
 
     def _tips(self, crack, site_line):
         """The crack's tips ``(x (2, k), outward (2, k), spacing (k,))``:
-        the open ends of the crack sites and the law's notch tips that no
-        crack site closes, those within ``reach`` spacings of each other
+        the open ends of the path sites ``crack`` (at their points on
+        their lines) and the law's notch tips that no crack site closes,
+        those within ``reach`` spacings of each other
         and facing the same way (within 60 degrees) merged into one at
         their centroid (a band several sites wide has one tip, and its
         stress is sampled around the band's middle)."""
@@ -229,11 +230,7 @@ class CrackTracker:
             # an end is closed by a crack site within reach of it and 60
             # degrees of its outward direction (a site does not close its
             # own ends)
-            near = cKDTree(xc.T).query_ball_point(xe.T, reach * he)
-            counts = np.array([len(q) for q in near])
-            end = np.repeat(np.arange(xe.shape[1]), counts)
-            other = np.concatenate([np.asarray(q, dtype=int) for q in near]) \
-                if counts.sum() else np.zeros(0, dtype=int)
+            end, other = _near(cKDTree(xc.T), xe, reach * he)
             v = xc[:, other] - xe[:, end]
             r = np.hypot(*v)
             along = (v * o[:, end]).sum(axis=0)
@@ -268,11 +265,7 @@ class CrackTracker:
         if k == 0:
             return outward
         law = self.law
-        near = self._tree.query_ball_point(xt.T, law.tip_radius * ht)
-        counts = np.array([len(n) for n in near])
-        site = np.concatenate([np.asarray(n, dtype=int) for n in near]) \
-            if counts.sum() else np.zeros(0, dtype=int)
-        tip = np.repeat(np.arange(k), counts)
+        tip, site = _near(self._tree, xt, law.tip_radius * ht)
         v = self.x[:, site] - xt[:, tip]
         r = np.hypot(*v)
         keep = ~site_failed[site] & (r >= ht[tip])
@@ -327,23 +320,28 @@ class CrackTracker:
         free = sites[~allowed[sites]]
         if free.size == 0 or xc.shape[1] == 0:
             return
-        d = lines[:2]
-        v = self.x[:, free][:, :, None] - xc[:, None, :]
-        along = (v * d[:, None, :]).sum(axis=0)
-        across = np.abs(-d[1][None] * self.x[0, free][:, None]
-                        + d[0][None] * self.x[1, free][:, None]
-                        - lines[2][None])
-        h = hc[None]
+        # the pairs (candidate, crack site) near enough: a crack site lies
+        # within half of width of its own line (beside sites) or about a
+        # spacing (path sites)
+        cand, site = _near(cKDTree(xc.T), self.x[:, free],
+                           (0.5 + self.law.width) * hc.max() + 1e-12)
+        d, h = lines[:2, site], hc[site]
+        xf = self.x[:, free[cand]]
+        along = ((xf - xc[:, site]) * d).sum(axis=0)
+        across = np.abs(_offset(d, xf) - lines[2, site])
         inside = (np.abs(along) <= 0.5 * h) & \
             (across <= 0.5 * self.law.width * h)
-        hit = inside.any(axis=1)
-        if not hit.any():
+        if not inside.any():
             return
-        nearest = np.argmin(np.where(inside, np.hypot(along, across),
-                                     np.inf), axis=1)[hit]
-        allowed[free[hit]] = True
-        new_line[:, free[hit]] = lines[:, nearest]
-        new_line[3, free[hit]] = 0.0
+        cand, site = cand[inside], site[inside]
+        # each candidate takes the line of its nearest crack site
+        order = np.lexsort((np.hypot(along[inside], across[inside]), cand))
+        cand, site = cand[order], site[order]
+        first = np.unique(cand, return_index=True)[1]
+        hit, nearest = free[cand[first]], site[first]
+        allowed[hit] = True
+        new_line[:, hit] = lines[:, nearest]
+        new_line[3, hit] = 0.0
 
     def _initiate(self, sites, crack, indicator, candidate, stress,
                   allowed, new_line):
@@ -441,6 +439,17 @@ def _williams(theta, r):
     mode2 = [-f * s * (2 + c * c3), f * s * c * c3, f * c * (1 - s * s3)]
     tee = [np.sqrt(r), one, one]
     return np.array([[mode1[m], mode2[m], tee[m]] for m in range(3)])
+
+
+def _near(tree, x, radius):
+    """The pairs ``(i, j)``: point ``x[:, i]`` ``(2, n)`` and the point
+    ``j`` of ``tree`` within ``radius`` (per point, or one) of it."""
+    near = tree.query_ball_point(x.T, radius)
+    counts = np.array([len(q) for q in near], dtype=int)
+    if counts.sum() == 0:
+        return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+    return (np.repeat(np.arange(x.shape[1]), counts),
+            np.concatenate([np.asarray(q, dtype=int) for q in near]))
 
 
 def _offset(d, x):
