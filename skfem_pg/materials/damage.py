@@ -3,7 +3,8 @@ r"""Damage laws for the J2 material: an uncoupled damage indicator
 strain and fails the point at a critical value (thesis 8.1); and
 brittle criteria on the elastic strain (:class:`CriticalStrainDamage`,
 :class:`NonlocalStrainDamage`) and on the stress
-(:class:`CriticalStressDamage`).
+(:class:`CriticalStressDamage`), and the crack tracking of either local
+criterion (:class:`CrackTracking`, experimental).
 
 :class:`JohnsonCookDamage` is Johnson and Cook's (1985) law without rate
 and temperature terms, as the thesis uses it:
