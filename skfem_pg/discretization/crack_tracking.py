@@ -98,25 +98,16 @@ class CrackTracker:
     """
 
     def __init__(self, basis, law):
-        if getattr(basis, "distributed", None) is not None:
-            raise NotImplementedError(
-                "crack tracking over the points of a basis on MPI ranks is "
-                "not built (a tip needs the sites of the neighbouring ranks "
-                "around it): run a tracked damage law serially")
         self.basis, self.law = basis, law
-        self.at, x, volumes, gather = point_sites(basis)
+        self.at, x, volumes, self._gather = point_sites(
+            basis, "crack tracking")
         if x.shape[0] != 2:
             raise NotImplementedError(
                 "{!r}: crack tracking is built in 2-D; a {}-D model's crack "
                 "is a surface, whose front is not tracked".format(
                     law, x.shape[0]))
         self.x = x
-        self.n_points = x.shape[1] if self.at is None else self.at.size
-        if self.at is None:
-            self.at = np.arange(self.n_points)
-            gather = sp.csr_matrix((volumes, (self.at, self.at)),
-                                   shape=(self.n_points, self.n_points))
-        self._gather = gather
+        self.n_points = self.at.size
         self.h = np.sqrt(volumes)  # each site's spacing
         self._tree = cKDTree(x.T)
         xn, dn = law.notch_tips, law.notch_directions

@@ -13,8 +13,9 @@ points are the family members (the flat layout of
 masked mean (by weight) at each particle comes first, then the bell over
 the particles within :math:`R` (weights: the particles' volumes), and
 each point takes its particle's mean.  On a scikit-fem basis the points
-are the Gauss points, weighted by ``dx``.  Two sparse products per
-evaluation; the operators are built once per basis.
+are the Gauss points, weighted by ``dx``, each its own site.  Four
+sparse products per evaluation; the operators are built once per basis
+(:func:`point_sites`, shared with the crack tracking).
 """
 import numpy as np
 import scipy.sparse as sp
@@ -35,25 +36,33 @@ def _bell(x, radius, volumes):
     return sp.csr_matrix((a, (i, j)), shape=(n, n))
 
 
-def point_sites(basis):
+def point_sites(basis, what):
     """Where a model's integration points on ``basis`` lie: ``(at, x,
-    volumes, gather)``.  On a family basis the sites are the particles:
-    ``at`` the points' particles (the members of the flat layout), ``x``
-    ``(d, n)`` and ``volumes`` the particles', ``gather`` the sparse
-    ``(n, N_q)`` matrix of the points' weights (row i: the points at
-    particle i).  On a scikit-fem basis every Gauss point is its own site:
-    ``at`` and ``gather`` are ``None``, ``x`` the Gauss points and
-    ``volumes`` their ``dx``."""
+    volumes, gather)``: ``at`` each point's site, ``x`` ``(d, n)`` and
+    ``volumes`` the sites', ``gather`` the sparse ``(n, N_q)`` matrix of
+    the points' weights (row i: the points at site i).  On a family basis
+    the sites are the particles (the points' members in the flat layout);
+    on a scikit-fem basis every Gauss point is its own site (its ``dx``).
+    A basis on MPI ranks is refused: ``what`` (a nonlocal mean, crack
+    tracking) needs the points of the neighbouring ranks."""
+    if getattr(basis, "distributed", None) is not None:
+        raise NotImplementedError(
+            "{} over the points of a basis on MPI ranks is not built (it "
+            "needs the points of the neighbouring ranks): run it serially"
+            .format(what))
     if is_family_basis(basis):
         particles = basis.particles
-        at = basis.families.members
+        at, x, volumes = (basis.families.members, particles.x,
+                          particles.volumes)
         w = basis.flat_weights().ravel()
-        gather = sp.csr_matrix((w, (at, np.arange(at.size))),
-                               shape=(particles.n, at.size))
-        return at, particles.x, particles.volumes, gather
-    x = np.asarray(basis.global_coordinates())
-    return (None, x.reshape(x.shape[0], -1),
-            np.asarray(basis.dx, dtype=float).ravel(), None)
+    else:
+        x = np.asarray(basis.global_coordinates())
+        x = x.reshape(x.shape[0], -1)
+        volumes = w = np.asarray(basis.dx, dtype=float).ravel()
+        at = np.arange(w.size)
+    gather = sp.csr_matrix((w, (at, np.arange(at.size))),
+                           shape=(x.shape[1], at.size))
+    return at, x, volumes, gather
 
 
 class NonlocalAverage:
@@ -79,19 +88,14 @@ class NonlocalAverage:
     """
 
     def __init__(self, basis, radius):
-        if getattr(basis, "distributed", None) is not None:
-            raise NotImplementedError(
-                "a nonlocal mean over the points of a basis on MPI ranks is "
-                "not built (it needs the points of the neighbouring ranks "
-                "within the radius): run a nonlocal damage law serially")
         if not radius > 0:
             raise ValueError("NonlocalAverage: the radius must be positive, "
                              "got {}".format(radius))
         self.basis, self.radius = basis, float(radius)
-        self.at, x, volumes, self._gather = point_sites(basis)
+        self.at, x, volumes, self._gather = point_sites(
+            basis, "a nonlocal mean")
         self._bell = _bell(x, self.radius, volumes)
-        self.n_points = (self.at.size if self.at is not None
-                         else self._bell.shape[0])
+        self.n_points = self.at.size
 
     def __repr__(self):
         return "NonlocalAverage(radius={:g}, {} points)".format(
@@ -107,12 +111,11 @@ class NonlocalAverage:
                 "NonlocalAverage: {} values and {} mask entries for the "
                 "{} points of the basis".format(values.size, m.size,
                                                 self.n_points))
-        if self._gather is not None:
-            num, den = self._gather @ (m * values), self._gather @ m
-            has = den > 0
-            mean = np.where(has, num / np.where(has, den, 1.0), 0.0)
-            num, den = self._bell @ mean, self._bell @ has.astype(float)
-        else:
-            num, den = self._bell @ (m * values), self._bell @ m
+        # the masked mean at each site, then the bell over the sites that
+        # have one (on a scikit-fem basis: each Gauss point is its site)
+        num, den = self._gather @ (m * values), self._gather @ m
+        has = den > 0
+        mean = np.where(has, num / np.where(has, den, 1.0), 0.0)
+        num, den = self._bell @ mean, self._bell @ has.astype(float)
         out = np.where(den > 0, num / np.where(den > 0, den, 1.0), 0.0)
-        return out if self.at is None else out[self.at]
+        return out[self.at]
