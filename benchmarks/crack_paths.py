@@ -21,7 +21,8 @@ crack tracking instead (:class:`~skfem_pg.materials.CrackTracking`: a
 point fails only on the path a crack tip chooses by the maximum
 tangential stress criterion; the notch tips given), beside PMB, into its
 own table (a run its ``hold_limit`` stops is reported as stopped, with
-what it held).  Beside them the failed cells
+what it held; the same runs with the limit lifted report the most the
+tracking held, and where).  Beside them the failed cells
 (PMB: particles), the drivers' energy balance, the steps and the seconds
 of each run, and its seconds over PMB's on the same nodes.
 
@@ -30,11 +31,13 @@ Run: ``python benchmarks/crack_paths.py --results benchmarks/README.md
 rows written as they come; 41 and 73 min measured, side by side on 2
 cores;
 ``--spacings`` and ``--models`` select a part; ``--tracked``, the same
-for each mesh).
+for each mesh: 32 and 41 min side by side).
 """
 import os
 import sys
 import time
+
+import numpy as np
 
 from harness import demo_parser, markdown_table, update_results
 
@@ -51,14 +54,20 @@ MODELS = ("PMB", "PG kept, strain", "PG kept, stress",
 #: ``--tracked``: the criteria with the crack tracking
 #: (:class:`~skfem_pg.materials.CrackTracking`, the notch tips given)
 TRACKED = ("PMB", "PG kept, stress, tracked",
-           "PG crack-aware, stress, tracked")
+           "PG crack-aware, stress, tracked",
+           "PG kept, stress, tracked, no hold limit",
+           "PG crack-aware, stress, tracked, no hold limit")
 HEADER = ["run", "mesh", "h (mm)", "particles",
           "initial, upper / lower (deg)", "further, upper / lower (deg)",
           "failed", "drivers' balance", "steps", "s", "s / PMB's"]
+#: ``--tracked``: and the most the tracking held
+HELD = "most held near tips / elsewhere (x criterion, at)"
 
 
 def run(model, mesh, h):
-    """One run: the table's cells after the first three."""
+    """One run: the table's cells after the first three (and, tracked,
+    the most the tracking held)."""
+    held = []
     if model == "PMB":
         (upper, lower), tr, m, basis, seconds = run_pmb(h, T_END, mesh)
         failed = int((m.damage() > 1 / 3).sum())
@@ -66,10 +75,12 @@ def run(model, mesh, h):
                              tr.history[-1]["relative_error"], tr.steps)
     else:
         t0 = time.perf_counter()
+        tracked = "tracked" in model
+        limit = {"hold_limit": np.inf} if "no hold limit" in model else {}
         try:
             (upper, lower), failed, balance, steps, seconds, m = run_pg(
                 h, T_END, "crack-aware" in model, mesh,
-                model.split(", ")[1], tracked=model.endswith("tracked"))
+                model.split(", ")[1], tracked=tracked, **limit)
         except TrackingError as err:  # the tracking's own check stopped it
             seconds = time.perf_counter() - t0
             text = str(err)
@@ -78,17 +89,23 @@ def run(model, mesh, h):
                 "(", 1)[1].rstrip(")")
             return ["", "stopped: a point held at {} x its criterion at "
                     "({})".format(ratio, where), "", "", "", "",
-                    "{:.1f}".format(seconds)], seconds
+                    "{:.1f}".format(seconds), ""], seconds
         n = m.basis.particles.n
+        if tracked:
+            most = m.history.crack_tracker().most_held
+            held = [" / ".join("{:.2f} at ({:.1f}, {:.1f})".format(
+                most[z][0], *most[z][1]) for z in ("near tips", "elsewhere"))]
     return [str(n),
             "{:.1f} / {:.1f}".format(upper[0], lower[0]),
             "{:.1f} / {:.1f}".format(upper[1], lower[1]),
             str(failed), "{:+.1e}".format(balance), str(steps),
-            "{:.1f}".format(seconds)], seconds
+            "{:.1f}".format(seconds)] + (held or [""]), seconds
 
 
 def main(meshes, spacings, models, results=None, section="crack_paths_"):
     rows = []
+    tracked = any("tracked" in m for m in models)
+    header = HEADER + ([HELD] if tracked else [])
     for mesh in meshes:
         for h in spacings:
             pmb = None
@@ -96,8 +113,9 @@ def main(meshes, spacings, models, results=None, section="crack_paths_"):
                 cells, seconds = run(model, mesh, h)
                 if model == "PMB":
                     pmb = seconds
-                rows.append([model, mesh, "{:g}".format(h)] + cells + [
-                    "" if pmb is None else "{:.1f}".format(seconds / pmb)])
+                rows.append([model, mesh, "{:g}".format(h)] + cells[:-1] + [
+                    "" if pmb is None else "{:.1f}".format(seconds / pmb)]
+                    + (cells[-1:] if tracked else []))
                 print(" | ".join(rows[-1]), flush=True)
                 text = (
                     "Kalthoff–Winkler to {:g} µs on {}: the crack's "
@@ -109,7 +127,7 @@ def main(meshes, spacings, models, results=None, section="crack_paths_"):
                     "strain or stress:\n\n".format(
                         T_END * 1e6, " and ".join(meshes), *INITIAL,
                         *FURTHER, EXPERIMENT)
-                    + markdown_table(HEADER, rows))
+                    + markdown_table(header, rows))
                 if results:  # row by row: a long run shows what it has
                     update_results(results, section + "_".join(meshes),
                                    text)

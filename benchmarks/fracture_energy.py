@@ -101,6 +101,10 @@ def row(name, basis, tr, seconds):
         return [name, str(basis.particles.n), "stopped at t = {:.3g} s "
                 "({})".format(tr.t, why), "", "", "", "",
                 "{:.1f}".format(seconds)]
+    if isinstance(tr, RuntimeError):  # an update's VC solve: why
+        return [name, str(basis.particles.n), "stopped in an update ({})"
+                .format(str(tr).split(": ")[1].split(" (")[0]), "", "", "",
+                "", "{:.1f}".format(seconds)]
     last = tr.history[-1]
     w = last["internal_work"]
     closure = last.get("closure")
@@ -117,13 +121,18 @@ HEADER = ["run", "particles", "steps",
 
 
 def integrate(model, basis, t_end=6e-5, **kw):
-    """``(basis, trajectory or the DynamicsError that stopped it,
-    seconds)`` of central differences to ``t_end``."""
+    """``(basis, trajectory or the error that stopped it (a
+    DynamicsError, or a crack-aware update's failed VC solve), seconds)``
+    of central differences to ``t_end``."""
     t0 = time.perf_counter()
     try:
         tr = pg.central_difference(model, pg.lumped_mass(basis, RHO), t_end,
                                    verbose=False, **kw)
     except DynamicsError as err:
+        tr = err
+    except RuntimeError as err:  # a crack-aware update's VC solve failed
+        if not str(err).startswith("VC "):
+            raise
         tr = err
     return basis, tr, time.perf_counter() - t0
 
@@ -157,7 +166,7 @@ def crack_measures(model, mesh, tr, h):
     failed; crack-aware: the removed cells) or the particles more than a
     third damaged (PMB) within 10 mm of the slot's line; the band, the
     failed cells' area over that length (PG)."""
-    if isinstance(tr, DynamicsError):
+    if isinstance(tr, RuntimeError):  # stopped (a DynamicsError too)
         return ["", "", ""]
     if isinstance(model, BondBased):
         x = model.basis.particles.x
@@ -185,7 +194,7 @@ def crack_measures(model, mesh, tr, h):
 def first_failure(tr):
     """The time (µs) of the first record with released energy, a table
     cell (records every 10 steps: to 2 µs at h = 2 mm, 1 µs at 1 mm)."""
-    if isinstance(tr, DynamicsError):
+    if isinstance(tr, RuntimeError):  # stopped (a DynamicsError too)
         return ""
     t = [r["t"] for r in tr.history if r.get("fracture", 0.0) > 0]
     return "{:.0f}".format(1e6 * t[0]) if t else "none"

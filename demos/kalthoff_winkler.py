@@ -36,9 +36,10 @@ strength; ``--criterion stress``; ``benchmarks/crack_paths.py`` runs
 both), and ``--tracked`` runs it with the crack tracking
 (:class:`~skfem_pg.materials.CrackTracking`: a point fails only on the
 path a crack tip chooses by the maximum tangential stress criterion, the
-notch tips given as crack tips; measured: on this plate every PG run
-stops with a ``TrackingError`` when the tracking holds a point beside
-its crack at twice its strength, ``benchmarks/README.md``).
+notch tips given as crack tips; measured: crack-aware families on the
+grid complete at 77-79 degrees, the other PG runs stop with a
+``TrackingError`` when the tracking holds a point away from the crack
+tips at twice its strength, ``benchmarks/README.md``).
 
 Prints each crack's direction to its notch: the chord from the notch tip
 to the centroid of the crack's points (particles more than a third

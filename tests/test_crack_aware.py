@@ -259,6 +259,40 @@ def test_the_history_follows_its_pairs_when_debris_leaves_no_family():
     assert np.array_equal(tags, 1e-9 * k_new.astype(float))
 
 
+def test_a_new_pair_takes_the_state_at_its_particle():
+    """Triangles cut along a slanted band: some families take members
+    they did not have (15 new pairs).  A new point (k, j) takes the
+    history and F_c of the point at its particle, (j, j), not its family
+    master's, (k, k): a failure and a tracked crack's line belong to the
+    material at j (with the master's, a tracked crack's lines reached
+    sites three spacings beside them on Kalthoff–Winkler)."""
+    mesh = fem.MeshTri.init_tensor(*(np.linspace(0, 1, 9),) * 2)
+    basis = pg.FamilyBasis(mesh, dim=2)
+    model = CrackAware(basis, STEEL)
+    from skfem_pg.formulations.updated_lagrange import point_keys
+    n = basis.particles.n
+    keys = point_keys(basis)
+    st = model.state(np.zeros(basis.N))
+    model.commit(st)
+    h = model.history.committed
+    for name in ("alpha", "damage"):  # tagged points
+        h[name] = 1e-9 * keys.astype(float).reshape(h[name].shape)
+    F = np.array(st["F"])
+    F[0, 0] += 1e-9 * keys.reshape(F.shape[2:])
+    c = mesh.p[:, mesh.t].mean(axis=1)
+    model.update(np.zeros(basis.N), F,
+                 np.abs(c[1] - 0.7 * c[0] - 0.1) < 0.08)
+    k_new = point_keys(model.current)
+    new = ~np.isin(k_new, keys)
+    assert new.sum() == 15
+    want = 1e-9 * np.where(new, (k_new % n) * (n + 1), k_new).astype(float)
+    h = model.history.committed
+    for name in ("alpha", "damage"):
+        assert np.array_equal(h[name].ravel(), want)
+    F_c = np.asarray(model.state(np.zeros(basis.N))["F"])[0, 0].ravel()
+    assert np.allclose(F_c - 1.0, want, rtol=0, atol=1e-15)
+
+
 def test_cells_fail_from_their_failed_points():
     """A cell fails when the failed share of its points reaches
     ``fraction``; then a piece smaller than ``min_piece`` goes with it."""

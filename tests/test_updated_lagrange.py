@@ -68,7 +68,9 @@ def test_rebuild_carries_a_homogeneous_state_and_the_history(name):
         assert ep_t > 1e-3 and abs(ep_u - ep_t) <= 1e-14
 
 
-def test_remap_takes_the_master_for_new_pairs():
+def test_remap_takes_the_master_or_the_member_for_new_pairs():
+    """A new (family, member) pair takes the family master's point, or
+    with ``donor="member"`` the point at its own particle."""
     p = pg.Particles.from_mesh(mesh())
     old = pg.FamilyBasis(p, dim=2)
     new = pg.FamilyBasis(p, dim=2, shape="WTE2", bond=False)
@@ -85,6 +87,15 @@ def test_remap_takes_the_master_for_new_pairs():
     want = [lookup.get(key, lookup[(key // n) * n + key // n])
             for key in kn.tolist()]
     assert np.array_equal(out[0], want)
+    # donor="member" (a crack-aware carry): a new pair (k, j) takes the
+    # point at its particle j, (j, j)
+    (out,) = remap_points(old, new, [keys_old[None]], donor="member")
+    want = [lookup.get(key, lookup[(key % n) * n + key % n])
+            for key in kn.tolist()]
+    assert not np.isin(kn, ko).all()  # there are new pairs
+    assert np.array_equal(out[0], want)
+    with pytest.raises(ValueError, match="donor"):
+        remap_points(old, new, [keys_old[None]], donor="nearest")
 
 
 def test_ul_by_name_and_dynamic_run_follows_tl():

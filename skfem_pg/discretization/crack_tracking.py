@@ -11,18 +11,22 @@ of Erdogan & Sih (1963), from the stress intensity factors fitted to the
 stress around it.  The points are grouped into *sites* (a family basis:
 the particles the points lie at; a scikit-fem basis: the Gauss points,
 :func:`~skfem_pg.discretization.nonlocal_mean.point_sites`);
-:math:`h_s = \sqrt{V_s}` is a site's spacing.  At an evaluation in which
+a site's spacing :math:`h_s` is the median distance to its four nearest
+sites.  At an evaluation in which
 some intact point reaches the criterion:
 
 1. the *crack* is the sites with a failed point; each carries the line
    :math:`(d_c, d_c^\perp \cdot x)` it failed on, and whether it failed
    on a tip's path (or started a crack) or beside the crack;
-2. an end :math:`\pm d_c` of a path site (at its point on its line: the
-   crack is the polyline its tips chose) is *open* when no other crack
-   site lies within ``reach`` spacings of it and 60 degrees of that
-   direction; with the law's notch tips that no crack site closes, the
-   open ends within ``reach`` of each other and facing the same way are
-   one *tip*, at their centroid, with their mean outward direction
+2. the front end :math:`+d_c` of a site on a tip's path, and both ends
+   :math:`\pm d_c` of a site that started a crack (at its point on its
+   line: the crack is the polyline its tips chose), is *open* when no
+   other crack site lies within ``reach`` spacings of it and 60 degrees
+   of that direction (a path grows forward: its back end faces the tip
+   it grew from); with the law's notch tips that no crack site closes
+   (within ``reach`` and the ``cone`` their kink may take), the open
+   ends within ``reach`` of each other and facing the same way are one
+   *tip*, at their centroid, with their mean outward direction
    :math:`o`;
 3. a tip's direction: in the frame whose x-axis is :math:`o` (the crack
    behind the tip), the near-tip fields of modes I and II and a T-stress,
@@ -34,21 +38,28 @@ some intact point reaches the criterion:
 4. a site may fail (all its points that reach the criterion) when its
    cell (the points nearest to it) crosses the strip one spacing wide
    and ``reach`` spacings long from a tip along its direction (the path,
-   about two sites wide), or when it lies beside a crack site (within
-   half a spacing along its line) and within half of ``width`` spacings
-   of that line (the crack widens about the line its tip chose; it
-   neither creeps sideways nor grows ahead of its tips); it carries that
-   line;
+   about two sites wide), or when it lies beside a crack site or a
+   notch tip (within half a spacing along its line; a notch's line is
+   its direction through its tip) and within half of ``width`` spacings
+   of that line (the crack widens about the line its tip chose, and
+   about a notch's end, its root; it neither creeps sideways nor grows
+   ahead of its tips); it carries that line;
 5. a site farther than ``exclusion`` spacings from every crack site and
    notch tip starts a new crack (the largest criterion among such sites
    within ``exclusion`` of each other), its line normal to its largest
    principal stress.
 
-Every other point that reaches the criterion is held just below it; one
-whose criterion exceeds ``hold_limit`` times the critical value raises
-:class:`TrackingError` naming it (the material would carry what it cannot:
-with the connectivity kept the families that span a tracked crack
-overstress its neighbours).  The
+Every other point that reaches the criterion is held just below it.
+Within ``tip_radius`` spacings of a tip that is the singular field: the
+largest principal stress peaks beside the path a tip takes (in mode II
+on the crack's flank, 1.73 times its value on the path at the same
+distance; in mode I at 60 degrees, 1.30 times), and the tip advances
+when its path reaches the criterion.  Elsewhere a held point whose
+criterion exceeds ``hold_limit`` times the critical value raises
+:class:`TrackingError` naming it (the material would carry what it
+cannot: with the connectivity kept the families that span a tracked
+crack overstress its flanks).  :attr:`CrackTracker.most_held` records
+the most held in both zones.  The
 points that fail carry their line in the history (``crack_line``), so
 that the state is the committed history alone (a cut Newton step, a
 checkpoint, a crack-aware rebuild carry it).  The work is done only at
@@ -71,6 +82,9 @@ class TrackingError(RuntimeError):
 #: half-angle (degrees) of the cone in which another crack site closes an
 #: end of a crack site
 _END_CONE = 60.0
+#: the role of a crack site that started a crack (its line's fourth
+#: entry; 1: on a tip's path, 0: beside the crack)
+_STARTED = 2.0
 
 
 class CrackTracker:
@@ -108,11 +122,25 @@ class CrackTracker:
                     law, x.shape[0]))
         self.x = x
         self.n_points = self.at.size
-        self.h = np.sqrt(volumes)  # each site's spacing
         self._tree = cKDTree(x.T)
+        # each site's spacing: the median distance to its four nearest
+        # sites (not the square root of its volume, which on an edge or
+        # a corner is a half or a quarter of its neighbours')
+        if x.shape[1] < 5:
+            raise ValueError("{!r}: {} site(s); the crack tracking needs at "
+                             "least five".format(law, x.shape[1]))
+        dist, _ = self._tree.query(x.T, k=5)
+        self.h = np.median(dist[:, 1:], axis=1)
         xn, dn = law.notch_tips, law.notch_directions
         self._notches = (xn, dn, self.h[self._tree.query(xn.T)[1]]
                          if xn.shape[1] else np.zeros(0))
+        #: ``{"near tips": (ratio, x), "elsewhere": (ratio, x)}``: the
+        #: largest criterion over its critical value the tracking has
+        #: held, at any evaluation, and where (the reference
+        #: configuration), within ``tip_radius`` spacings of a tip and
+        #: elsewhere; ``(0, nan)`` before any
+        self.most_held = {zone: (0.0, np.full(2, np.nan))
+                          for zone in ("near tips", "elsewhere")}
 
     def __repr__(self):
         return "CrackTracker({!r}, {} sites)".format(self.law, self.x.shape[1])
@@ -123,7 +151,7 @@ class CrackTracker:
         below ``Dc``, and the points' crack lines ``(4, n)`` (direction
         :math:`d` and offset :math:`d^\perp \cdot x` of the line through
         the tip that let them fail, :math:`d^\perp = (-d_y, d_x)`, and 1
-        on a tip's path or where a crack started, 0 beside it) with the
+        on a tip's path, 2 where a crack started, 0 beside it) with the
         ones failing now set.  ``sigma``: the points' Cauchy stresses
         ``(n, 3, 3)`` before failure; ``failed``, ``line``: the committed
         failures and lines."""
@@ -156,32 +184,62 @@ class CrackTracker:
                                      site_line)
         d_tip = self._tip_directions(xt, outward, ht, stress, site_failed)
         self._path(sites, xt, d_tip, ht, allowed, new_line)
-        self._beside(sites, self.x[:, crack], site_line[:, crack],
-                     self.h[crack], allowed, new_line)
+        # the crack widens beside its sites and beside the notch tips (a
+        # notch's end is the root of its crack)
+        xn, dn, hn = self._notches
+        self._beside(sites, np.hstack([self.x[:, crack], xn]), np.hstack([
+            site_line[:, crack], np.vstack([dn, _offset(dn, xn),
+                                            np.ones(xn.shape[1])])]),
+            np.concatenate([self.h[crack], hn]), allowed, new_line)
         self._initiate(sites, crack, indicator, candidate, stress, allowed,
                        new_line)
         ok = allowed[at]
         held = candidate & ~ok
-        if held.any() and indicator[held].max() > self.law.hold_limit * Dc:
-            k = np.flatnonzero(held)[np.argmax(indicator[held])]
-            over = held & (indicator > self.law.hold_limit * Dc)
-            raise TrackingError(
-                "{!r}: {} point(s) held off the crack's path at up to {:.3g} "
-                "times the criterion (point {} at particle {}, ({}) in the "
-                "reference configuration), above hold_limit = {:g}: the "
-                "material carries what it cannot (the crack's neighbours "
-                "overstressed or the crack arrested); widen the crack "
-                "(width), use crack-aware families, or run it untracked"
-                .format(self.law, int(over.sum()), indicator[k] / Dc, k,
-                        at[k], ", ".join("{:.6g}".format(c)
-                                         for c in self.x[:, at[k]]),
-                        self.law.hold_limit))
+        if held.any():
+            self._check_held(indicator / Dc, held, xt, ht)
         out = indicator.copy()
         out[held] = np.nextafter(Dc, -np.inf)
         new = candidate & ok
         line = line.copy()
         line[:, new] = new_line[:, at[new]]
         return out, line
+
+    def _check_held(self, ratio, held, xt, ht):
+        """Record the most the ``held`` points carry (``ratio``: their
+        criterion over its critical value) within ``tip_radius`` spacings
+        of a tip ``xt`` (spacings ``ht``) and elsewhere; raise
+        :class:`TrackingError` for one elsewhere above ``hold_limit``."""
+        law = self.law
+        idx = np.flatnonzero(held)
+        near = np.zeros(idx.size, dtype=bool)
+        if xt.shape[1]:
+            i, j = _near(cKDTree(xt.T), self.x[:, self.at[idx]],
+                         law.tip_radius * ht.max())
+            close = np.hypot(*(self.x[:, self.at[idx[i]]] - xt[:, j])) \
+                <= law.tip_radius * ht[j]
+            near[i[close]] = True
+        for zone, mask in (("near tips", near), ("elsewhere", ~near)):
+            if mask.any():
+                k = idx[mask][np.argmax(ratio[idx[mask]])]
+                if ratio[k] > self.most_held[zone][0]:
+                    self.most_held[zone] = (ratio[k],
+                                            self.x[:, self.at[k]].copy())
+        far = idx[~near]
+        if far.size == 0 or ratio[far].max() <= law.hold_limit:
+            return
+        k = far[np.argmax(ratio[far])]
+        raise TrackingError(
+            "{!r}: {} point(s) held off the crack's path, farther than "
+            "tip_radius from its tips, at up to {:.3g} times the criterion "
+            "(point {} at particle {}, ({}) in the reference "
+            "configuration), above hold_limit = {:g}: the material carries "
+            "what it cannot (the crack's neighbours overstressed or the "
+            "crack arrested); widen the crack (width), use crack-aware "
+            "families, or run it untracked".format(
+                law, int((ratio[far] > law.hold_limit).sum()), ratio[k], k,
+                self.at[k], ", ".join("{:.6g}".format(c)
+                                      for c in self.x[:, self.at[k]]),
+                law.hold_limit))
 
     def _site_stress(self, sigma, mask):
         """The in-plane Cauchy stress ``(3, n_sites)`` (xx, yy, xy) of each
@@ -196,7 +254,8 @@ class CrackTracker:
     def _tips(self, crack, site_line):
         """The crack's tips ``(x (2, k), outward (2, k), spacing (k,))``:
         the open ends of the path sites ``crack`` (at their points on
-        their lines) and the law's notch tips that no crack site closes,
+        their lines; front ends, and back ends of the sites that started
+        a crack) and the law's notch tips that no crack site closes,
         those within ``reach`` spacings of each other
         and facing the same way (within 60 degrees) merged into one at
         their centroid (a band several sites wide has one tip, and its
@@ -210,23 +269,28 @@ class CrackTracker:
         xc = xc - nrm * ((nrm * xc).sum(axis=0) - site_line[2, crack])
         reach = self.law.reach
         xn, dn, hn = self._notches
-        # every end, the notches' first: (position, outward, spacing)
-        xe = np.hstack([xn, xc, xc])
-        o = np.hstack([dn, d, -d])
-        he = np.concatenate([hn, hc, hc])
+        # every end, the notches' first: (position, outward, spacing); a
+        # site on a tip's path grows forward only (its tip lies behind
+        # it), a site that started a crack both ways
+        both = site_line[3, crack] == _STARTED
+        xe = np.hstack([xn, xc, xc[:, both]])
+        o = np.hstack([dn, d, -d[:, both]])
+        he = np.concatenate([hn, hc, hc[both]])
         if xe.shape[1] == 0:
             return np.zeros((2, 0)), np.zeros((2, 0)), np.zeros(0)
+        # an end is closed by a crack site within reach of it and 60
+        # degrees of its outward direction (a site does not close its own
+        # ends); a notch tip by one within the cone its kink may take
+        cone = np.full(xe.shape[1], _END_CONE)
+        cone[:xn.shape[1]] = max(_END_CONE, self.law.cone)
         closed = np.zeros(xe.shape[1], dtype=bool)
         if crack.size:
-            # an end is closed by a crack site within reach of it and 60
-            # degrees of its outward direction (a site does not close its
-            # own ends)
             end, other = _near(cKDTree(xc.T), xe, reach * he)
             v = xc[:, other] - xe[:, end]
             r = np.hypot(*v)
             along = (v * o[:, end]).sum(axis=0)
             shut = (r > 1e-12 * he[end]) & (
-                along >= np.cos(np.radians(_END_CONE)) * r)
+                along >= np.cos(np.radians(cone[end])) * r)
             closed[end[shut]] = True
         keep = ~closed
         xe, o, he = xe[:, keep], o[:, keep], he[keep]
@@ -372,7 +436,7 @@ class CrackTracker:
         allowed[start] = True
         d = np.stack([-np.sin(angle), np.cos(angle)])
         new_line[:, start] = np.vstack([d, _offset(d, self.x[:, start]),
-                                        np.ones(start.size)])
+                                        np.full(start.size, _STARTED)])
 
 
 def mts_angle(KI, KII):

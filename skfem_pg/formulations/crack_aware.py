@@ -55,11 +55,14 @@ master):
 
   :math:`G` the rebuilt (reference) derivatives and :math:`F_c` the
   committed deformation gradient at the update, carried per point
-  :math:`(k, j)` (a new point takes its master's); the deformation is
+  :math:`(k, j)`; the deformation is
   continuous across an update, and before the first update this is the
   total Lagrangian formulation exactly.  The committed history follows
   the points (:func:`~skfem_pg.formulations.updated_lagrange.
-  remap_points`);
+  remap_points`); a new point :math:`(k, j)` (a family the update gave
+  a member it did not have) takes :math:`F_c` and the history of the
+  point at its particle, :math:`(j, j)` (a failure and a tracked crack's
+  line belong to the material there);
 * **energy**: the stored energy of the points an update removes, and the
   change of the remaining points' weights, is released: it is added to
   :meth:`CrackAware.fracture_energy` (part of the dissipation an explicit
@@ -454,7 +457,11 @@ class _SemiTotal:
         return point_keys(self.current)
 
     def _carry(self, new, F):
-        return carry_points(self.history, self.current, new, F)
+        # a new point (k, j) takes the state at its particle j, that of
+        # (j, j): a failure, a tracked crack's line belong to the
+        # material there
+        return carry_points(self.history, self.current, new, F,
+                            donor="member")
 
     def _set_basis(self, new):
         self.current = new

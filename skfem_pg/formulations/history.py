@@ -126,7 +126,8 @@ class History:
     def crack_tracker(self):
         """The :class:`~skfem_pg.discretization.crack_tracking.
         CrackTracker` of the material's tracked damage law over the points
-        (built again when the model's point basis changes)."""
+        (built again when the model's point basis changes, keeping its
+        record of the most it held)."""
         basis = None if self.points is None else self.points()
         law = self.material.damage
         if basis is None:
@@ -135,7 +136,10 @@ class History:
                 "points (History(material, points=...))".format(law))
         t = self._tracker
         if t is None or t.basis is not basis or t.law is not law:
-            self._tracker = t = CrackTracker(basis, law)
+            self._tracker = CrackTracker(basis, law)
+            if t is not None and t.law is law:  # what it held so far
+                self._tracker.most_held = t.most_held
+            t = self._tracker
         return t
 
     # the stateless-material interface the formulations call

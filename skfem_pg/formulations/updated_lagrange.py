@@ -56,36 +56,48 @@ def point_keys(basis):
     return k * basis.particles.n + np.asarray(fam.members)
 
 
-def remap_points(old, new, arrays):
+def remap_points(old, new, arrays, donor="master"):
     """Point arrays (last axis flat over the points of ``old``) on the
     points of ``new``: the same (family, member) pair where it exists,
-    else the family's master."""
+    else the family's master (``donor="master"``: the family's state) or
+    the member's own master, the point at the same particle
+    (``donor="member"``: the material's state there; the family's master
+    where the member has no family)."""
+    if donor not in ("master", "member"):
+        raise ValueError("donor must be 'master' or 'member', got {!r}"
+                         .format(donor))
     ko, kn = point_keys(old), point_keys(new)
     if ko.shape == kn.shape and np.array_equal(ko, kn):
         return arrays
     n = new.particles.n
     order = np.argsort(ko)
-    pos = np.searchsorted(ko[order], kn)
-    pos = np.minimum(pos, len(ko) - 1)
-    hit = ko[order][pos] == kn
-    src = order[pos]
-    k = kn // n
-    master = np.searchsorted(ko[order], k * n + k)
-    src = np.where(hit, src, order[np.minimum(master, len(ko) - 1)])
+    sk = ko[order]
+
+    def find(keys):
+        pos = np.minimum(np.searchsorted(sk, keys), len(ko) - 1)
+        return order[pos], sk[pos] == keys
+
+    src, hit = find(kn)
+    k, j = kn // n, kn % n
+    at_master, _ = find(k * n + k)
+    if donor == "member":
+        at_member, has = find(j * n + j)
+        at_master = np.where(has, at_member, at_master)
+    src = np.where(hit, src, at_master)
     return [a[..., src] for a in arrays]
 
 
-def carry_points(history, old, new, F):
+def carry_points(history, old, new, F, donor="master"):
     """Carry the point data of basis ``old`` to the points of ``new``
-    (:func:`remap_points`): the committed arrays of ``history`` (a
-    :class:`~skfem_pg.formulations.history.History` or ``None``), in
-    place, and the deformation gradients ``F`` ``(d, d, 1, N_q)``, whose
-    remapped copy is returned."""
+    (:func:`remap_points`, a new point's from ``donor``): the committed
+    arrays of ``history`` (a :class:`~skfem_pg.formulations.history.
+    History` or ``None``), in place, and the deformation gradients ``F``
+    ``(d, d, 1, N_q)``, whose remapped copy is returned."""
     d = F.shape[0]
     c = None if history is None else history.committed
     names = sorted(c) if c is not None else []
     arrays = remap_points(old, new, [np.asarray(F).reshape(d * d, -1)] + [
-        c[k].reshape(-1, c[k].shape[-1]) for k in names])
+        c[k].reshape(-1, c[k].shape[-1]) for k in names], donor=donor)
     if c is not None:
         history.committed = {k: a.reshape(c[k].shape[:-1] + (-1,))
                              for k, a in zip(names, arrays[1:])}

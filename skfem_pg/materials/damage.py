@@ -228,13 +228,11 @@ class CrackTracking:
     sites around the tip, beside the crack within its ``width``, or far
     from every crack (a new one); :class:`~skfem_pg.discretization.
     crack_tracking.CrackTracker` has the algorithm.  The lengths are in
-    units of each site's spacing :math:`\sqrt{V}` (a particle's volume).
-    2-D, serial; a formulation that binds its points evaluates it (the PG
-    and FE displacement and mean-dilatation models, crack-aware ones
-    included).  Experimental: on Kalthoff–Winkler every PG run holds
-    points beside its crack at more than twice their strength and stops
-    on ``hold_limit``; lifted, its paths change with the spacing
-    (``benchmarks/README.md``).
+    units of each site's spacing (the median distance to its four
+    nearest sites).  2-D, serial; a formulation that binds its points
+    evaluates it (the PG and FE displacement and mean-dilatation models,
+    crack-aware ones included).  Experimental: see
+    ``benchmarks/README.md`` for what it gives on Kalthoff–Winkler.
 
     Parameters
     ----------
@@ -265,9 +263,12 @@ class CrackTracking:
         notch's frame.  Without them a crack starts where the criterion is
         first reached, normal to the largest principal stress there.
     hold_limit
-        A point held off the path whose criterion exceeds this many times
-        its critical value raises :class:`~skfem_pg.discretization.
-        crack_tracking.TrackingError` (``numpy.inf``: no limit).
+        A point held off the path, farther than ``tip_radius`` spacings
+        from every tip, whose criterion exceeds this many times its
+        critical value raises :class:`~skfem_pg.discretization.
+        crack_tracking.TrackingError` (``numpy.inf``: no limit; near a
+        tip the held excess is the singular field's, module docstring of
+        :mod:`~skfem_pg.discretization.crack_tracking`).
 
     Examples
     --------
