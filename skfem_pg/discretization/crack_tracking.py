@@ -113,7 +113,7 @@ class CrackTracker:
 
     def __init__(self, basis, law):
         self.basis, self.law = basis, law
-        self.at, x, volumes, self._gather = point_sites(
+        self.at, x, _, self._gather = point_sites(
             basis, "crack tracking")
         if x.shape[0] != 2:
             raise NotImplementedError(
