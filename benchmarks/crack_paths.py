@@ -83,12 +83,10 @@ def run(model, mesh, h):
                 model.split(", ")[1], tracked=tracked, **limit)
         except TrackingError as err:  # the tracking's own check stopped it
             seconds = time.perf_counter() - t0
-            text = str(err)
-            ratio = text.split("at up to ")[1].split(" times")[0]
-            where = text.split(" in the reference")[0].rsplit(
-                "(", 1)[1].rstrip(")")
-            return ["", "stopped: a point held at {} x its criterion at "
-                    "({})".format(ratio, where), "", "", "", "",
+            return ["", "stopped: a point held at {:.3g} x its criterion "
+                    "at ({})".format(err.ratio, ", ".join(
+                        "{:.6g}".format(c) for c in err.position)),
+                    "", "", "", "",
                     "{:.1f}".format(seconds), ""], seconds
         n = m.basis.particles.n
         if tracked:

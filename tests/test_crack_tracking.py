@@ -113,8 +113,10 @@ def test_a_tracked_criterion_fails_the_path_and_holds_the_rest():
     k = np.flatnonzero(held & (r > 0.75))[0]
     over[k] = 2.5
     with pytest.raises(TrackingError, match="point {} at particle {}".format(
-            k, at[k])):
+            k, at[k])) as stop:
         tr(over, sigma, failed, line, 1.0)
+    assert stop.value.ratio == 2.5
+    assert np.array_equal(stop.value.position, x[:, at[k]])
     over = ind.copy()
     k = np.flatnonzero(held & (r <= 0.75))[0]
     over[k] = 2.5

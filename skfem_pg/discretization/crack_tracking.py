@@ -76,7 +76,13 @@ from .nonlocal_mean import point_sites
 class TrackingError(RuntimeError):
     """A tracked criterion holds a point off the crack's path far above
     its critical value (:class:`~skfem_pg.materials.damage.CrackTracking`'s
-    ``hold_limit``)."""
+    ``hold_limit``): ``ratio``, its criterion over the critical value, and
+    ``position`` ``(2,)``, its site in the reference configuration."""
+
+    def __init__(self, message, ratio=np.nan, position=(np.nan, np.nan)):
+        super().__init__(message)
+        self.ratio = float(ratio)
+        self.position = np.asarray(position, dtype=float)
 
 
 #: half-angle (degrees) of the cone in which another crack site closes an
@@ -90,7 +96,7 @@ _STARTED = 2.0
 class CrackTracker:
     """The crack tracking of ``law`` (a :class:`~skfem_pg.materials.damage.
     CrackTracking`) over the integration points of ``basis`` (module
-    docstring): ``tracker(indicator, sigma, failed, direction, Dc)``.
+    docstring): ``tracker(indicator, sigma, failed, line, Dc)``.
 
     Examples
     --------
@@ -228,6 +234,7 @@ class CrackTracker:
         if far.size == 0 or ratio[far].max() <= law.hold_limit:
             return
         k = far[np.argmax(ratio[far])]
+        where = self.x[:, self.at[k]]
         raise TrackingError(
             "{!r}: {} point(s) held off the crack's path, farther than "
             "tip_radius from its tips, at up to {:.3g} times the criterion "
@@ -237,9 +244,8 @@ class CrackTracker:
             "crack arrested); widen the crack (width), use crack-aware "
             "families, or run it untracked".format(
                 law, int((ratio[far] > law.hold_limit).sum()), ratio[k], k,
-                self.at[k], ", ".join("{:.6g}".format(c)
-                                      for c in self.x[:, self.at[k]]),
-                law.hold_limit))
+                self.at[k], ", ".join("{:.6g}".format(c) for c in where),
+                law.hold_limit), ratio[k], where)
 
     def _site_stress(self, sigma, mask):
         """The in-plane Cauchy stress ``(3, n_sites)`` (xx, yy, xy) of each
