@@ -62,6 +62,7 @@ from skfem_pg.formulations import BondBased, CrackAware, model_for, \
 from skfem_pg.formulations.crack_aware import cell_failure
 from skfem_pg.materials import (CriticalStrainDamage, J2Plasticity,
                                 NonlocalStrainDamage)
+from skfem_pg.errors import VCSolveError
 from skfem_pg.solvers import DynamicsError, ExplicitControls
 
 #: N, mm, s: maraging steel (Kalthoff–Winkler, demos/kalthoff_winkler.py)
@@ -101,7 +102,7 @@ def row(name, basis, tr, seconds):
         return [name, str(basis.particles.n), "stopped at t = {:.3g} s "
                 "({})".format(tr.t, why), "", "", "", "",
                 "{:.1f}".format(seconds)]
-    if isinstance(tr, RuntimeError):  # an update's VC solve: why
+    if isinstance(tr, VCSolveError):  # an update's VC solve: why
         return [name, str(basis.particles.n), "stopped in an update ({})"
                 .format(str(tr).split(": ")[1].split(" (")[0]), "", "", "",
                 "", "{:.1f}".format(seconds)]
@@ -130,9 +131,7 @@ def integrate(model, basis, t_end=6e-5, **kw):
                                    verbose=False, **kw)
     except DynamicsError as err:
         tr = err
-    except RuntimeError as err:  # a crack-aware update's VC solve failed
-        if not str(err).startswith("VC "):
-            raise
+    except VCSolveError as err:  # a crack-aware update's VC solve failed
         tr = err
     return basis, tr, time.perf_counter() - t0
 

@@ -21,7 +21,7 @@ from .discretization import (particles, families, shape, corrections,
                              vc, loads)
 from .scenes import meshing, reference
 from .errors import (ParticleError, FamilyError, CorrectionError,
-                     UnsupportedMeshError, SlowAssemblyWarning,
+                     VCSolveError, UnsupportedMeshError, SlowAssemblyWarning,
                      MixedBasisWarning, SecondDerivativeError)
 from .discretization import (Particles, Families, FamilyBasis, assemble,
                              block_pattern, BilinearForm, LinearForm,
@@ -42,7 +42,7 @@ __all__ = ["Particles", "Families", "FamilyBasis", "assemble",
            "write_vtu", "discretization", "formulations", "materials",
            "solvers", "analysis", "scenes", "families", "shape",
            "corrections", "vc", "meshing", "particles", "loads",
-           "ParticleError", "FamilyError", "CorrectionError",
+           "ParticleError", "FamilyError", "CorrectionError", "VCSolveError",
            "UnsupportedMeshError", "SecondDerivativeError", "registry",
            "register_formulation",
            "Scene", "newton", "newmark", "central_difference",

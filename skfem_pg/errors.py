@@ -21,6 +21,13 @@ class CorrectionError(FamilyError):
     derivatives)."""
 
 
+class VCSolveError(CorrectionError, RuntimeError):
+    """The VC system (5.18) of these families has no solution to working
+    precision: its (reduced) matrix is singular, or its iterative solve
+    stopped short.  A :class:`CorrectionError`, and a ``RuntimeError``
+    (the type these solves raised before it existed)."""
+
+
 class SingularSystemError(ValueError):
     """A linear system has no unique solution (rigid-body modes left free
     by too few Dirichlet conditions, a mechanism) or its solve did not

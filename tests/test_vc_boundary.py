@@ -98,9 +98,13 @@ def test_v4_and_vc2_with_s_solve_their_constraints_by_lu():
 
 def test_singular_reduced_systems_raise():
     # V4 with sn: the reduced system is singular to working precision
-    with pytest.raises(RuntimeError, match="V4 with boundary variant 'sn'"):
+    with pytest.raises(pg.VCSolveError,
+                       match="V4 with boundary variant 'sn'") as err:
         pg.FamilyBasis(square(10, 0.3, seed=1), dim=2, shape="WTE2",
                        vc="V4", vc_boundary="sn")
+    # a CorrectionError, and a RuntimeError as before the type existed
+    assert isinstance(err.value, pg.CorrectionError)
+    assert isinstance(err.value, RuntimeError)
 
 
 def test_bad_boundary_options_are_named():

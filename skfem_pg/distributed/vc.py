@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from . import petsc as pt
+from ..errors import VCSolveError
 from .comm import mpi, petsc, raise_together
 from ..discretization.vc.local import (family_shares, local_vc_correction,
                                        smoothed_gradients)
@@ -139,7 +140,7 @@ def solve_pinned(part, rows, cols, vals, fid, B, b, anchors, min_norm=True):
             res.aypx(-1.0, rhs)      # LU's)
             ksp.solve(res, dx)
             if ksp.getConvergedReason() < 0:
-                raise RuntimeError(
+                raise VCSolveError(
                     "the distributed VC solve (GMRES + {}) did not "
                     "converge (reason {}); use vc_solver='direct'".format(
                         ksp.getPC().getType(), ksp.getConvergedReason()))
@@ -230,7 +231,7 @@ def vc_correction(part, system, variant="V5", solver="auto", exclude=None,
     alpha, its, err = part.comm.bcast(
         (alpha, its if alpha is not None else 0, err), root=0)
     if err is not None:
-        raise RuntimeError("the distributed VC solve failed on rank 0: "
+        raise VCSolveError("the distributed VC solve failed on rank 0: "
                            "{}".format(err))
     return _finish(part, parts, Qs, alpha.reshape(-1, d)[fid], r0, grouped,
                    variant, solver + " (rank 0)", nf, its, boundary, t0)

@@ -41,6 +41,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
+from ...errors import VCSolveError
+
 BOUNDARY_VARIANTS = ("min-norm", "p", "s", "sn")
 
 
@@ -127,7 +129,7 @@ def reduction(masters, area, boundary, n_particles, active, full=None):
 def solve_reduced(A, b, R, T):
     """Solve the square reduced system ``(R A T) γ = R b`` by sparse LU;
     returns ``α = T γ``.  Raises ``ValueError`` if it is not square and
-    ``RuntimeError`` if it is singular."""
+    :class:`~skfem_pg.errors.VCSolveError` if it is singular."""
     K = (R @ A @ T).tocsc()
     if K.shape[0] != K.shape[1]:
         raise ValueError(
@@ -137,7 +139,7 @@ def solve_reduced(A, b, R, T):
     try:
         lu = spl.splu(K, permc_spec="COLAMD")
     except RuntimeError as err:
-        raise RuntimeError("the reduced VC system is singular ({}): the "
+        raise VCSolveError("the reduced VC system is singular ({}): the "
                            "interior families cannot satisfy the interior "
                            "constraints".format(err)) from None
     rb = R @ b
@@ -146,7 +148,7 @@ def solve_reduced(A, b, R, T):
     res = np.linalg.norm(K @ g - rb)
     if not np.all(np.isfinite(g)) or res > 1e-8 * max(np.linalg.norm(rb),
                                                        1e-300):
-        raise RuntimeError(
+        raise VCSolveError(
             "the reduced VC system is singular to working precision "
             "(relative residual {:.1e} after LU); this boundary variant "
             "does not regularise it — use another one".format(

@@ -28,6 +28,7 @@ import scipy.sparse.linalg as spl
 from scipy.sparse.csgraph import connected_components
 
 from . import boundary as vc_boundary
+from ...errors import VCSolveError
 from .boundary import BOUNDARY_VARIANTS
 from ..corrections import bond_projectors
 from ..shape import mls1_master_values
@@ -213,7 +214,7 @@ class _AMGSolve:
             self.iterations += len(res)
             rel = np.linalg.norm(self.A @ out[:, j] - cols[:, j]) / nb
             if not rel <= 1e3 * self.tol:
-                raise RuntimeError("AMG-GMRES on the VC system stopped at "
+                raise VCSolveError("AMG-GMRES on the VC system stopped at "
                                    "relative residual {:.1e}".format(rel))
         sol = np.empty_like(out)
         sol[self.p] = out
@@ -297,7 +298,7 @@ def solve_pinned_lu(PhiT, masters, B, b, x, active, refine=2,
                 Ac, symmetric_mode=False))
         sol = lu.solve(rhs)
     if not np.all(np.isfinite(sol)):
-        raise RuntimeError("the pinned constraint matrix is singular")
+        raise VCSolveError("the pinned constraint matrix is singular")
     beta = np.zeros((nf, d))
     beta[cols] = sol[:, :d]
     # refinement steps for the LU; AMG-GMRES has reached 1e-12 already
@@ -544,7 +545,7 @@ def vc_correction(system, variant="V5", solver="auto", tol=1e-14,
         try:
             alpha = vc_boundary.solve_reduced(matrix(), b, R, T)
         except RuntimeError as err:
-            raise RuntimeError("VC {} with boundary variant {!r}: {}".format(
+            raise VCSolveError("VC {} with boundary variant {!r}: {}".format(
                 variant, boundary, err)) from None
         its, unknowns = 2, T.shape[1]
         notes.append("boundary {}: {} equations and unknowns".format(

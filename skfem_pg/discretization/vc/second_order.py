@@ -50,6 +50,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spl
 
 from . import boundary as vc_boundary
+from ...errors import VCSolveError
 from .first_order import VCReport, constraint_residual
 
 
@@ -223,7 +224,7 @@ def vc2_correction(system, area2, exclude=None, tol=1e-15, maxiter=None,
         try:
             sol = vc_boundary.solve_reduced(A, rhs.reshape(-1, d), R, T)
         except RuntimeError as err:
-            raise RuntimeError("VC2 with boundary variant 's': {}"
+            raise VCSolveError("VC2 with boundary variant 's': {}"
                                .format(err)) from None
         alpha = sol.reshape(len(fam), d + 1, d)
         its, solver = 2, "direct"
