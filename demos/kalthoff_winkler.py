@@ -52,7 +52,7 @@ on the square grid PMB 69 degrees at 2 mm and 72 at 1 mm, PG kept 64 and
 82-88 (it climbs the column of cells above the notch tip); on gmsh
 triangles every model changes with the spacing: PMB 56-60 at 2 mm and
 68-70 at 1 mm, PG kept 56-60 and 75-85 (at 1 mm its crack starts up the
-notch's face), crack-aware 56-68 and 72-74.  The far edge also cracks
+notch's face), crack-aware 56-68 and 72-86.  The far edge also cracks
 where the reflected wave turns tensile (a known feature of 2-D models of
 this test); the directions leave that region out (they use the points
 above the upper notch and below the lower one).  Writes
